@@ -1,0 +1,19 @@
+# All dependencies come from Debian 12 packages through find_package (no vendored copies).
+# scripts/install-deps.sh installs them.
+find_package(Threads REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(fmt REQUIRED)
+find_package(CLI11 REQUIRED)
+
+# Asio standalone has no CMake package in Debian: an INTERFACE target over its header.
+find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)
+if(NOT TARGET asio::asio)
+  add_library(asio::asio INTERFACE IMPORTED)
+  set_target_properties(asio::asio PROPERTIES INTERFACE_INCLUDE_DIRECTORIES ${ASIO_INCLUDE_DIR}
+                                              INTERFACE_COMPILE_DEFINITIONS ASIO_STANDALONE)
+  target_link_libraries(asio::asio INTERFACE Threads::Threads)
+endif()
+
+if(CANFLEET_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()

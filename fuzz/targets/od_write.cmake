@@ -1,0 +1,1 @@
+canfleet_fuzz_target(od_write DEPS canfleet_canopen_od)

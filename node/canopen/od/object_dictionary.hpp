@@ -1,0 +1,116 @@
+#pragma once
+/// @file The object dictionary (CiA 301 §7.4): objects, their sub-objects, and access-checked
+/// reads and writes with hooks through which services and device code compute values and veto or
+/// react to writes.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "node/canopen/od/abort_code.hpp"
+#include "node/canopen/od/types.hpp"
+#include "node/canopen/od/value.hpp"
+
+namespace canfleet::canopen {
+
+/// Who is asking. SDO requests obey access types, limits and validators; RPDOs write mapped
+/// objects (mappability is checked when the mapping is made); the device itself bypasses access
+/// types, limits and validators (it writes its own read-only inputs) but listeners still run.
+enum class Origin : std::uint8_t { kSdo, kPdo, kDevice };
+
+struct SubObject;
+
+/// Called before a value is read; may refresh `sub.value` or refuse with an abort code
+/// (e.g. 1003h beyond the current number of errors answers kNoData).
+using ReadHook = std::function<SdoAbort(SubObject& sub, Origin origin)>;
+/// Called before a write is committed, after type/length/limit checks; returns kNone to accept.
+using WriteValidator = std::function<SdoAbort(const SubObject& sub, std::span<const std::uint8_t> data, Origin origin)>;
+/// Called after a write was committed.
+using WriteListener = std::function<void(SubObject& sub, Origin origin)>;
+
+/// One sub-index of an object (a VAR object has exactly one, at sub-index 0).
+struct SubObject {
+  std::uint16_t index = 0;
+  std::uint8_t sub_index = 0;
+  std::string name;
+  DataType type = DataType::kUnsigned8;
+  Access access = Access::kRw;
+  bool pdo_mappable = false;
+  std::optional<Bytes> low_limit;   ///< encoded like the value
+  std::optional<Bytes> high_limit;  ///< encoded like the value
+  Bytes default_value;              ///< encoded; node-ID not yet added (see default_adds_node_id)
+  bool default_adds_node_id = false;  ///< EDS "$NODEID+x": the node-ID is added when applied
+  Bytes value;                        ///< the current value, encoded
+  std::uint32_t obj_flags = 0;        ///< CiA 306 ObjFlags, kept for round trips
+
+  std::vector<ReadHook> read_hooks;
+  std::vector<WriteValidator> validators;
+  std::vector<WriteListener> listeners;
+
+  /// The default with the node-ID applied, encoded like the value.
+  Bytes DefaultFor(std::uint8_t node_id) const;
+  /// Size in bits for PDO mapping (8 × byte size for fixed types, 0 for variable-length types).
+  std::uint32_t BitLength() const;
+};
+
+/// One object: VAR, ARRAY or RECORD (DOMAIN/DEFTYPE/DEFSTRUCT are kept for EDS round trips).
+struct Object {
+  std::uint16_t index = 0;
+  std::string name;
+  ObjectCode code = ObjectCode::kVar;
+  std::uint32_t obj_flags = 0;
+  std::uint8_t compact_sub_obj = 0;  ///< CiA 306 CompactSubObj as read (0 = expanded)
+  std::map<std::uint8_t, SubObject> subs;
+};
+
+/// A whole dictionary. Objects and sub-objects never move once added, so services may keep
+/// pointers to them (the PDO path resolves its mapping to SubObject pointers once).
+class ObjectDictionary {
+ public:
+  using Objects = std::map<std::uint16_t, Object>;
+
+  /// Adds or replaces an object. Sub-objects get `index` filled in.
+  Object& Add(Object object);
+  /// Adds a VAR object in one call (common in tests and device code).
+  SubObject& AddVar(std::uint16_t index, std::string name, DataType type, Access access, Bytes default_value,
+                    bool pdo_mappable = false);
+
+  Object* Find(std::uint16_t index);
+  const Object* Find(std::uint16_t index) const;
+  SubObject* Find(std::uint16_t index, std::uint8_t sub);
+  const SubObject* Find(std::uint16_t index, std::uint8_t sub) const;
+
+  /// Finds a sub-object, or says which abort code a client gets: kNoObject or kNoSubIndex.
+  SdoAbort Lookup(std::uint16_t index, std::uint8_t sub, SubObject*& out);
+
+  /// Reads a value on behalf of `origin`: existence, access (kWriteOnly) and read hooks.
+  SdoAbort Read(std::uint16_t index, std::uint8_t sub, Bytes& out, Origin origin = Origin::kSdo);
+  /// Writes a value on behalf of `origin`: existence, access (kReadOnly), length (kLengthTooHigh/Low),
+  /// limits (kValueTooHigh/Low), BOOLEAN range, validators; then commits and runs listeners.
+  SdoAbort Write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                 Origin origin = Origin::kSdo);
+  /// The same checks as Write for an already-resolved sub-object (the hot path of RPDOs).
+  SdoAbort Write(SubObject& sub, std::span<const std::uint8_t> data, Origin origin);
+
+  /// Device-side typed access. Get returns 0 for a missing entry; Set writes with Origin::kDevice.
+  std::uint64_t GetUnsigned(std::uint16_t index, std::uint8_t sub) const;
+  std::int64_t GetSigned(std::uint16_t index, std::uint8_t sub) const;
+  SdoAbort SetUnsigned(std::uint16_t index, std::uint8_t sub, std::uint64_t value);
+  SdoAbort SetSigned(std::uint16_t index, std::uint8_t sub, std::int64_t value);
+
+  /// Restores the defaults of every object with index in [first, last] (reset node: 1000h–FFFFh;
+  /// reset communication: 1000h–1FFFh), applying `node_id` to "$NODEID" defaults. Listeners run.
+  void RestoreDefaults(std::uint16_t first, std::uint16_t last, std::uint8_t node_id);
+
+  const Objects& objects() const { return objects_; }
+  Objects& objects() { return objects_; }
+
+ private:
+  Objects objects_;
+};
+
+}  // namespace canfleet::canopen

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The test command: installs what it needs, configures, builds and runs every test.
+#   scripts/test.sh              full build + every test (unit, system, fuzz smoke)
+#   scripts/test.sh --sanitize   ASan+UBSan build, unit tests only
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=full
+[ "${1:-}" = "--sanitize" ] && mode=sanitize
+
+scripts/install-deps.sh
+
+jobs=$(nproc)
+common=(-G Ninja -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+
+if [ "$mode" = sanitize ]; then
+  cmake -S . -B build-asan "${common[@]}" -DCMAKE_BUILD_TYPE=Debug -DCANFLEET_SANITIZE=ON >/dev/null
+  cmake --build build-asan -j "$jobs"
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  ctest --test-dir build-asan -L unit -j "$jobs" --output-on-failure
+  exit 0
+fi
+
+cmake -S . -B build "${common[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build -j "$jobs"
+ctest --test-dir build -j "$jobs" --output-on-failure
+
+scripts/fuzz.sh "${FUZZ_SECONDS:-15}"
