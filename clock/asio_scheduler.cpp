@@ -2,9 +2,12 @@
 
 namespace canfleet {
 
-AsioScheduler::AsioScheduler(asio::io_context& io) : os_timer_(io), epoch_(std::chrono::steady_clock::now()) {}
+AsioScheduler::AsioScheduler(asio::io_context& io)
+    : os_timer_(io), epoch_(std::chrono::steady_clock::now()) {}
 
-AsioScheduler::~AsioScheduler() { os_timer_.cancel(); }
+AsioScheduler::~AsioScheduler() {
+  os_timer_.cancel();
+}
 
 TimePoint AsioScheduler::Now() const {
   return TimePoint{std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now() - epoch_)};

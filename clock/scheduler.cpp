@@ -7,7 +7,8 @@ namespace canfleet {
 
 Scheduler::~Scheduler() {
   // Timers must not outlive their scheduler; detach any left so their destructors are harmless.
-  for (Timer* t : heap_) t->heap_index_ = Timer::kNotArmed;
+  for (Timer* t : heap_)
+    t->heap_index_ = Timer::kNotArmed;
 }
 
 std::optional<TimePoint> Scheduler::NextDeadline() const {
@@ -93,11 +94,19 @@ Timer::Timer(Scheduler& scheduler, std::function<void()> on_expiry)
   assert(on_expiry_);
 }
 
-Timer::~Timer() { Cancel(); }
+Timer::~Timer() {
+  Cancel();
+}
 
-void Timer::StartAt(TimePoint deadline) { scheduler_.Arm(*this, deadline); }
-void Timer::StartAfter(Duration delay) { StartAt(scheduler_.Now() + delay); }
-void Timer::Cancel() { scheduler_.Disarm(*this); }
+void Timer::StartAt(TimePoint deadline) {
+  scheduler_.Arm(*this, deadline);
+}
+void Timer::StartAfter(Duration delay) {
+  StartAt(scheduler_.Now() + delay);
+}
+void Timer::Cancel() {
+  scheduler_.Disarm(*this);
+}
 
 void SimulatedScheduler::AdvanceTo(TimePoint t) {
   if (t < now_) t = now_;

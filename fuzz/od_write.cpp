@@ -20,7 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return d;
   }();
   if (size < 4) return 0;
-  std::uint16_t index = static_cast<std::uint16_t>(0x1017 + (data[0] % 8) * (data[1] & 1 ? 1 : 0x1000 - 0x17 + 0x1000));
+  std::uint16_t index =
+      static_cast<std::uint16_t>(0x1017 + (data[0] % 8) * (data[1] & 1 ? 1 : 0x1000 - 0x17 + 0x1000));
   std::uint8_t sub = data[2] % 3;
   Origin origin = static_cast<Origin>(data[3] % 3);
   std::span<const std::uint8_t> payload(data + 4, size - 4);

@@ -15,7 +15,8 @@ int HexDigit(char c) {
 
 CanFrame Frame(std::string_view text) {
   auto hash = text.find('#');
-  if (hash == std::string_view::npos || hash == 0) throw std::invalid_argument("no '#' in frame: " + std::string(text));
+  if (hash == std::string_view::npos || hash == 0)
+    throw std::invalid_argument("no '#' in frame: " + std::string(text));
   CanFrame f;
   auto id_text = text.substr(0, hash);
   for (char c : id_text) {
@@ -36,7 +37,8 @@ CanFrame Frame(std::string_view text) {
     if (HexDigit(c) < 0) throw std::invalid_argument("bad data in frame: " + std::string(text));
     hex += c;
   }
-  if (hex.size() % 2 != 0 || hex.size() > 16) throw std::invalid_argument("bad data length: " + std::string(text));
+  if (hex.size() % 2 != 0 || hex.size() > 16)
+    throw std::invalid_argument("bad data length: " + std::string(text));
   f.dlc = static_cast<std::uint8_t>(hex.size() / 2);
   for (std::size_t i = 0; i < f.dlc; ++i) {
     f.data[i] = static_cast<std::uint8_t>(HexDigit(hex[2 * i]) << 4 | HexDigit(hex[2 * i + 1]));
@@ -50,7 +52,8 @@ BusProbe::BusProbe(LoopbackBus& bus, std::string name) : port_(bus.Attach(std::m
 
 std::vector<std::string> BusProbe::Received() const {
   std::vector<std::string> out;
-  for (const auto& f : frames_) out.push_back(ToCandump(f));
+  for (const auto& f : frames_)
+    out.push_back(ToCandump(f));
   return out;
 }
 

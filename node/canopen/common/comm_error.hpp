@@ -11,7 +11,8 @@ namespace canfleet::canopen {
 enum class CommErrorKind : std::uint8_t {
   kHeartbeatTimeout,   ///< detail = node-ID of the silent producer (1016h); EMCY 8130h
   kLifeGuardTimeout,   ///< node guarding: no guard RTR within guard time × life time factor; EMCY 8130h
-  kRpdoTimeout,        ///< detail = RPDO number (1-based); deadline of the RPDO event timer expired; EMCY 8250h/8100h
+  kRpdoTimeout,        ///< detail = RPDO number (1-based); deadline of the RPDO event timer expired; EMCY
+                       ///< 8250h/8100h
   kRpdoTooShort,       ///< detail = RPDO number; fewer bytes than mapped; EMCY 8210h, not applied
   kRpdoTooLong,        ///< detail = RPDO number; more bytes than mapped; EMCY 8220h
   kSyncLength,         ///< SYNC with an unexpected DLC; EMCY 8240h

@@ -24,21 +24,21 @@ enum class SdoAbort : std::uint32_t {
   kParameterIncompatible = 0x06040043,  ///< general parameter incompatibility
   kInternalIncompatible = 0x06040047,   ///< general internal incompatibility in the device
   kHardwareError = 0x06060000,          ///< access failed due to a hardware error
-  kTypeMismatch = 0x06070010,           ///< data type does not match, length of service parameter does not match
-  kLengthTooHigh = 0x06070012,          ///< data type does not match, length of service parameter too high
-  kLengthTooLow = 0x06070013,           ///< data type does not match, length of service parameter too low
-  kNoSubIndex = 0x06090011,             ///< sub-index does not exist
-  kInvalidValue = 0x06090030,           ///< invalid value for parameter (download only)
-  kValueTooHigh = 0x06090031,           ///< value of parameter written too high (download only)
-  kValueTooLow = 0x06090032,            ///< value of parameter written too low (download only)
-  kMaxBelowMin = 0x06090036,            ///< maximum value is less than minimum value
-  kNoResource = 0x060A0023,             ///< resource not available: SDO connection
-  kGeneralError = 0x08000000,           ///< general error
-  kCannotTransfer = 0x08000020,         ///< data cannot be transferred or stored to the application
-  kLocalControl = 0x08000021,           ///< ... because of local control
-  kDeviceState = 0x08000022,            ///< ... because of the present device state
-  kNoDictionary = 0x08000023,           ///< object dictionary dynamic generation fails or no OD present
-  kNoData = 0x08000024,                 ///< no data available
+  kTypeMismatch = 0x06070010,    ///< data type does not match, length of service parameter does not match
+  kLengthTooHigh = 0x06070012,   ///< data type does not match, length of service parameter too high
+  kLengthTooLow = 0x06070013,    ///< data type does not match, length of service parameter too low
+  kNoSubIndex = 0x06090011,      ///< sub-index does not exist
+  kInvalidValue = 0x06090030,    ///< invalid value for parameter (download only)
+  kValueTooHigh = 0x06090031,    ///< value of parameter written too high (download only)
+  kValueTooLow = 0x06090032,     ///< value of parameter written too low (download only)
+  kMaxBelowMin = 0x06090036,     ///< maximum value is less than minimum value
+  kNoResource = 0x060A0023,      ///< resource not available: SDO connection
+  kGeneralError = 0x08000000,    ///< general error
+  kCannotTransfer = 0x08000020,  ///< data cannot be transferred or stored to the application
+  kLocalControl = 0x08000021,    ///< ... because of local control
+  kDeviceState = 0x08000022,     ///< ... because of the present device state
+  kNoDictionary = 0x08000023,    ///< object dictionary dynamic generation fails or no OD present
+  kNoData = 0x08000024,          ///< no data available
 };
 
 /// The CiA 301 text of an abort code ("unknown abort code" for values outside the table).

@@ -88,8 +88,8 @@ SdoAbort ObjectDictionary::Read(std::uint16_t index, std::uint8_t sub_index, Byt
   return SdoAbort::kNone;
 }
 
-SdoAbort ObjectDictionary::Write(std::uint16_t index, std::uint8_t sub_index, std::span<const std::uint8_t> data,
-                                 Origin origin) {
+SdoAbort ObjectDictionary::Write(std::uint16_t index, std::uint8_t sub_index,
+                                 std::span<const std::uint8_t> data, Origin origin) {
   SubObject* sub = nullptr;
   if (auto rc = Lookup(index, sub_index, sub); rc != SdoAbort::kNone) return rc;
   return Write(*sub, data, origin);
@@ -105,7 +105,8 @@ SdoAbort ObjectDictionary::Write(SubObject& sub, std::span<const std::uint8_t> d
   if (checked) {
     if (sub.type == DataType::kBoolean && data[0] > 1) return SdoAbort::kInvalidValue;
     if (!IsVariableLength(sub.type)) {
-      if (sub.high_limit && CompareNumeric(sub.type, data, *sub.high_limit) > 0) return SdoAbort::kValueTooHigh;
+      if (sub.high_limit && CompareNumeric(sub.type, data, *sub.high_limit) > 0)
+        return SdoAbort::kValueTooHigh;
       if (sub.low_limit && CompareNumeric(sub.type, data, *sub.low_limit) < 0) return SdoAbort::kValueTooLow;
     }
     for (auto& validate : sub.validators) {
@@ -114,7 +115,8 @@ SdoAbort ObjectDictionary::Write(SubObject& sub, std::span<const std::uint8_t> d
   }
   // assign() reuses the existing buffer when the size does not grow: no allocation per RPDO.
   sub.value.assign(data.begin(), data.end());
-  for (auto& listener : sub.listeners) listener(sub, origin);
+  for (auto& listener : sub.listeners)
+    listener(sub, origin);
   return SdoAbort::kNone;
 }
 
@@ -148,7 +150,8 @@ void ObjectDictionary::RestoreDefaults(std::uint16_t first, std::uint16_t last, 
       auto def = sub.DefaultFor(node_id);
       if (sub.value == def) continue;
       sub.value = std::move(def);
-      for (auto& listener : sub.listeners) listener(sub, Origin::kDevice);
+      for (auto& listener : sub.listeners)
+        listener(sub, Origin::kDevice);
     }
   }
 }

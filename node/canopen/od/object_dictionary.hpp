@@ -28,7 +28,8 @@ struct SubObject;
 /// (e.g. 1003h beyond the current number of errors answers kNoData).
 using ReadHook = std::function<SdoAbort(SubObject& sub, Origin origin)>;
 /// Called before a write is committed, after type/length/limit checks; returns kNone to accept.
-using WriteValidator = std::function<SdoAbort(const SubObject& sub, std::span<const std::uint8_t> data, Origin origin)>;
+using WriteValidator =
+    std::function<SdoAbort(const SubObject& sub, std::span<const std::uint8_t> data, Origin origin)>;
 /// Called after a write was committed.
 using WriteListener = std::function<void(SubObject& sub, Origin origin)>;
 
@@ -40,9 +41,9 @@ struct SubObject {
   DataType type = DataType::kUnsigned8;
   Access access = Access::kRw;
   bool pdo_mappable = false;
-  std::optional<Bytes> low_limit;   ///< encoded like the value
-  std::optional<Bytes> high_limit;  ///< encoded like the value
-  Bytes default_value;              ///< encoded; node-ID not yet added (see default_adds_node_id)
+  std::optional<Bytes> low_limit;     ///< encoded like the value
+  std::optional<Bytes> high_limit;    ///< encoded like the value
+  Bytes default_value;                ///< encoded; node-ID not yet added (see default_adds_node_id)
   bool default_adds_node_id = false;  ///< EDS "$NODEID+x": the node-ID is added when applied
   Bytes value;                        ///< the current value, encoded
   std::uint32_t obj_flags = 0;        ///< CiA 306 ObjFlags, kept for round trips

@@ -80,65 +80,111 @@ bool IsUnsigned(DataType type) {
   }
 }
 
-bool IsReal(DataType type) { return type == DataType::kReal32 || type == DataType::kReal64; }
+bool IsReal(DataType type) {
+  return type == DataType::kReal32 || type == DataType::kReal64;
+}
 
-bool IsKnown(DataType type) { return FixedSize(type).has_value() || IsVariableLength(type); }
+bool IsKnown(DataType type) {
+  return FixedSize(type).has_value() || IsVariableLength(type);
+}
 
-bool IsReadable(Access access) { return access != Access::kWo; }
-bool IsWritable(Access access) { return access != Access::kRo && access != Access::kConst; }
+bool IsReadable(Access access) {
+  return access != Access::kWo;
+}
+bool IsWritable(Access access) {
+  return access != Access::kRo && access != Access::kConst;
+}
 
 std::string_view ToString(DataType type) {
   switch (type) {
-    case DataType::kBoolean: return "BOOLEAN";
-    case DataType::kInteger8: return "INTEGER8";
-    case DataType::kInteger16: return "INTEGER16";
-    case DataType::kInteger24: return "INTEGER24";
-    case DataType::kInteger32: return "INTEGER32";
-    case DataType::kInteger40: return "INTEGER40";
-    case DataType::kInteger48: return "INTEGER48";
-    case DataType::kInteger56: return "INTEGER56";
-    case DataType::kInteger64: return "INTEGER64";
-    case DataType::kUnsigned8: return "UNSIGNED8";
-    case DataType::kUnsigned16: return "UNSIGNED16";
-    case DataType::kUnsigned24: return "UNSIGNED24";
-    case DataType::kUnsigned32: return "UNSIGNED32";
-    case DataType::kUnsigned40: return "UNSIGNED40";
-    case DataType::kUnsigned48: return "UNSIGNED48";
-    case DataType::kUnsigned56: return "UNSIGNED56";
-    case DataType::kUnsigned64: return "UNSIGNED64";
-    case DataType::kReal32: return "REAL32";
-    case DataType::kReal64: return "REAL64";
-    case DataType::kVisibleString: return "VISIBLE_STRING";
-    case DataType::kOctetString: return "OCTET_STRING";
-    case DataType::kUnicodeString: return "UNICODE_STRING";
-    case DataType::kTimeOfDay: return "TIME_OF_DAY";
-    case DataType::kTimeDifference: return "TIME_DIFFERENCE";
-    case DataType::kDomain: return "DOMAIN";
+    case DataType::kBoolean:
+      return "BOOLEAN";
+    case DataType::kInteger8:
+      return "INTEGER8";
+    case DataType::kInteger16:
+      return "INTEGER16";
+    case DataType::kInteger24:
+      return "INTEGER24";
+    case DataType::kInteger32:
+      return "INTEGER32";
+    case DataType::kInteger40:
+      return "INTEGER40";
+    case DataType::kInteger48:
+      return "INTEGER48";
+    case DataType::kInteger56:
+      return "INTEGER56";
+    case DataType::kInteger64:
+      return "INTEGER64";
+    case DataType::kUnsigned8:
+      return "UNSIGNED8";
+    case DataType::kUnsigned16:
+      return "UNSIGNED16";
+    case DataType::kUnsigned24:
+      return "UNSIGNED24";
+    case DataType::kUnsigned32:
+      return "UNSIGNED32";
+    case DataType::kUnsigned40:
+      return "UNSIGNED40";
+    case DataType::kUnsigned48:
+      return "UNSIGNED48";
+    case DataType::kUnsigned56:
+      return "UNSIGNED56";
+    case DataType::kUnsigned64:
+      return "UNSIGNED64";
+    case DataType::kReal32:
+      return "REAL32";
+    case DataType::kReal64:
+      return "REAL64";
+    case DataType::kVisibleString:
+      return "VISIBLE_STRING";
+    case DataType::kOctetString:
+      return "OCTET_STRING";
+    case DataType::kUnicodeString:
+      return "UNICODE_STRING";
+    case DataType::kTimeOfDay:
+      return "TIME_OF_DAY";
+    case DataType::kTimeDifference:
+      return "TIME_DIFFERENCE";
+    case DataType::kDomain:
+      return "DOMAIN";
   }
   return "UNKNOWN";
 }
 
 std::string_view ToString(Access access) {
   switch (access) {
-    case Access::kRo: return "ro";
-    case Access::kWo: return "wo";
-    case Access::kRw: return "rw";
-    case Access::kRwr: return "rwr";
-    case Access::kRww: return "rww";
-    case Access::kConst: return "const";
+    case Access::kRo:
+      return "ro";
+    case Access::kWo:
+      return "wo";
+    case Access::kRw:
+      return "rw";
+    case Access::kRwr:
+      return "rwr";
+    case Access::kRww:
+      return "rww";
+    case Access::kConst:
+      return "const";
   }
   return "rw";
 }
 
 std::string_view ToString(ObjectCode code) {
   switch (code) {
-    case ObjectCode::kNull: return "NULL";
-    case ObjectCode::kDomain: return "DOMAIN";
-    case ObjectCode::kDefType: return "DEFTYPE";
-    case ObjectCode::kDefStruct: return "DEFSTRUCT";
-    case ObjectCode::kVar: return "VAR";
-    case ObjectCode::kArray: return "ARRAY";
-    case ObjectCode::kRecord: return "RECORD";
+    case ObjectCode::kNull:
+      return "NULL";
+    case ObjectCode::kDomain:
+      return "DOMAIN";
+    case ObjectCode::kDefType:
+      return "DEFTYPE";
+    case ObjectCode::kDefStruct:
+      return "DEFSTRUCT";
+    case ObjectCode::kVar:
+      return "VAR";
+    case ObjectCode::kArray:
+      return "ARRAY";
+    case ObjectCode::kRecord:
+      return "RECORD";
   }
   return "VAR";
 }

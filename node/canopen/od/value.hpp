@@ -20,24 +20,27 @@ using Bytes = std::vector<std::uint8_t>;
 
 /// Encodes an integer, bool or floating value in `size` little-endian bytes (default: sizeof(T)).
 template <typename T>
-  requires std::is_arithmetic_v<T>
-Bytes EncodeLe(T value, std::size_t size = sizeof(T)) {
+requires std::is_arithmetic_v<T> Bytes EncodeLe(T value, std::size_t size = sizeof(T)) {
   std::uint64_t raw = 0;
   if constexpr (std::is_floating_point_v<T>) {
-    if constexpr (sizeof(T) == 4) raw = std::bit_cast<std::uint32_t>(value);
-    else raw = std::bit_cast<std::uint64_t>(value);
+    if constexpr (sizeof(T) == 4)
+      raw = std::bit_cast<std::uint32_t>(value);
+    else
+      raw = std::bit_cast<std::uint64_t>(value);
   } else {
     raw = static_cast<std::uint64_t>(value);
   }
   Bytes out(size);
-  for (std::size_t i = 0; i < size; ++i) out[i] = static_cast<std::uint8_t>(raw >> (8 * i));
+  for (std::size_t i = 0; i < size; ++i)
+    out[i] = static_cast<std::uint8_t>(raw >> (8 * i));
   return out;
 }
 
 /// Zero-extended little-endian read of up to 8 bytes.
 inline std::uint64_t DecodeUnsignedLe(std::span<const std::uint8_t> bytes) {
   std::uint64_t v = 0;
-  for (std::size_t i = 0; i < bytes.size() && i < 8; ++i) v |= std::uint64_t{bytes[i]} << (8 * i);
+  for (std::size_t i = 0; i < bytes.size() && i < 8; ++i)
+    v |= std::uint64_t{bytes[i]} << (8 * i);
   return v;
 }
 
@@ -58,6 +61,8 @@ int CompareNumeric(DataType type, std::span<const std::uint8_t> a, std::span<con
 /// Human-readable value for logs and CLIs: decimal numbers, quoted strings, hex for domains.
 std::string FormatValue(DataType type, std::span<const std::uint8_t> bytes);
 
-inline Bytes ToBytes(std::string_view text) { return Bytes(text.begin(), text.end()); }
+inline Bytes ToBytes(std::string_view text) {
+  return Bytes(text.begin(), text.end());
+}
 
 }  // namespace canfleet::canopen

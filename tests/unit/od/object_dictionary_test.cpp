@@ -10,13 +10,16 @@ class ObjectDictionaryTest : public ::testing::Test {
  protected:
   void SetUp() override {
     od.AddVar(0x1000, "Device type", DataType::kUnsigned32, Access::kRo, EncodeLe<std::uint32_t>(0x000F0194));
-    od.AddVar(0x1017, "Producer heartbeat time", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0));
+    od.AddVar(0x1017, "Producer heartbeat time", DataType::kUnsigned16, Access::kRw,
+              EncodeLe<std::uint16_t>(0));
     od.AddVar(0x6125, "Autozero", DataType::kUnsigned32, Access::kWo, EncodeLe<std::uint32_t>(0));
     od.AddVar(0x5555, "Start in operational", DataType::kBoolean, Access::kRw, {0});
-    auto& limited = od.AddVar(0x2090, "Window", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(1000));
+    auto& limited =
+        od.AddVar(0x2090, "Window", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(1000));
     limited.low_limit = EncodeLe<std::uint16_t>(10);
     limited.high_limit = EncodeLe<std::uint16_t>(10000);
-    auto& signed_limited = od.AddVar(0x3030, "Min current", DataType::kInteger16, Access::kRw, EncodeLe<std::int16_t>(0));
+    auto& signed_limited =
+        od.AddVar(0x3030, "Min current", DataType::kInteger16, Access::kRw, EncodeLe<std::int16_t>(0));
     signed_limited.low_limit = EncodeLe<std::int16_t>(-100);
     signed_limited.high_limit = EncodeLe<std::int16_t>(2000);
     od.AddVar(0x1008, "Name", DataType::kVisibleString, Access::kConst, ToBytes("AX020506"));

@@ -1,0 +1,62 @@
+#include "bus/fault_confinement.hpp"
+
+namespace canfleet {
+
+std::optional<ControllerEvent> FaultConfinement::Update() {
+  ControllerState next = state_;
+  if (state_ == ControllerState::kBusOff) return std::nullopt;  // only Recover() leaves bus-off
+  if (tec_ > 255)
+    next = ControllerState::kBusOff;
+  else if (tec_ >= 128 || rec_ >= 128)
+    next = ControllerState::kErrorPassive;
+  else
+    next = ControllerState::kErrorActive;
+  if (next == state_) return std::nullopt;
+  state_ = next;
+  return Snapshot();
+}
+
+std::optional<ControllerEvent> FaultConfinement::OnTransmitSuccess() {
+  if (state_ == ControllerState::kBusOff) return std::nullopt;
+  if (tec_ > 0) --tec_;
+  return Update();
+}
+
+std::optional<ControllerEvent> FaultConfinement::OnTransmitError(TransmitError error) {
+  if (state_ == ControllerState::kBusOff) return std::nullopt;
+  if (error == TransmitError::kAck && state_ == ControllerState::kErrorPassive) return std::nullopt;
+  tec_ = static_cast<std::uint16_t>(tec_ + 8);
+  return Update();
+}
+
+std::optional<ControllerEvent> FaultConfinement::OnReceiveSuccess() {
+  if (state_ == ControllerState::kBusOff) return std::nullopt;
+  if (rec_ > 127)
+    rec_ = 127;  // "a value between 119 and 127": we choose 127
+  else if (rec_ > 0)
+    --rec_;
+  return Update();
+}
+
+std::optional<ControllerEvent> FaultConfinement::OnReceiveError() {
+  if (state_ == ControllerState::kBusOff) return std::nullopt;
+  if (rec_ < 255) ++rec_;
+  return Update();
+}
+
+std::optional<ControllerEvent> FaultConfinement::Recover() {
+  if (state_ != ControllerState::kBusOff) return std::nullopt;
+  tec_ = 0;
+  rec_ = 0;
+  state_ = ControllerState::kErrorActive;
+  return Snapshot();
+}
+
+std::optional<ControllerEvent> FaultConfinement::ForceBusOff() {
+  if (state_ == ControllerState::kBusOff) return std::nullopt;
+  tec_ = 256;
+  state_ = ControllerState::kBusOff;
+  return Snapshot();
+}
+
+}  // namespace canfleet
