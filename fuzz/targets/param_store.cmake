@@ -1,0 +1,1 @@
+canfleet_fuzz_target(param_store DEPS canfleet_canopen_storage)
