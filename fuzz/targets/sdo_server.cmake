@@ -1,0 +1,1 @@
+canfleet_fuzz_target(sdo_server DEPS canfleet_canopen_sdo)
