@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
   python3 python3-venv can-utils
+  qemu-system-x86 busybox-static cpio
 )
 
 missing=()

@@ -2,28 +2,9 @@
 // reuses the reserved lists, the fixed frame ring and the OD values in place.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
-
 #include "clock/scheduler.hpp"
 #include "node/canopen/emcy/emcy.hpp"
-
-namespace {
-bool counting = false;
-std::size_t allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (counting) ++allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
+#include "tests/support/allocation_counter.hpp"
 
 namespace canfleet::canopen {
 namespace {
@@ -66,11 +47,9 @@ TEST(EmcyAllocation, RaiseAndClearDoNotAllocateInSteadyState) {
   emcy.OnSent([](const CanFrame&) {});
   RaiseAndClearFour(emcy);  // warm-up
 
-  allocations = 0;
-  counting = true;
+  auto before = canfleet::test::AllocationCount();
   RaiseAndClearFour(emcy);
-  counting = false;
-  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(canfleet::test::AllocationCount() - before, 0u);
   EXPECT_EQ(port.sent, 16u);
 
   // With an inhibit time the frames wait in the ring and a Timer sends them (the warm-up lets the
@@ -78,12 +57,10 @@ TEST(EmcyAllocation, RaiseAndClearDoNotAllocateInSteadyState) {
   ASSERT_EQ(od.Write(0x1015, 0, EncodeLe<std::uint16_t>(10)), SdoAbort::kNone);
   RaiseAndClearFour(emcy);
   scheduler.Advance(10ms);
-  allocations = 0;
-  counting = true;
+  before = canfleet::test::AllocationCount();
   RaiseAndClearFour(emcy);
   scheduler.Advance(10ms);
-  counting = false;
-  EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(canfleet::test::AllocationCount() - before, 0u);
   EXPECT_EQ(port.sent, 32u);
 }
 

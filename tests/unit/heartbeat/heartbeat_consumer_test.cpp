@@ -4,31 +4,13 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <new>
 #include <string>
 #include <vector>
 
 #include "bus/loopback_bus.hpp"
+#include "tests/support/allocation_counter.hpp"
 #include "tests/support/bus_probe.hpp"
 #include "tests/unit/heartbeat/heartbeat_test_support.hpp"
-
-// Counts heap allocations so a test can prove the frame path does not allocate.
-namespace {
-std::size_t g_allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace canfleet::canopen {
 namespace {
@@ -409,10 +391,10 @@ TEST(HeartbeatConsumerAllocation, FramePathDoesNotAllocate) {
     consumer.OnFrame(boot_up);
   };
   round();  // the scheduler's timer heap grows once to hold both timers
-  const std::size_t before = g_allocations;
+  const auto before = canfleet::test::AllocationCount();
   for (int i = 0; i < 100; ++i)
     round();
-  EXPECT_EQ(g_allocations, before);
+  EXPECT_EQ(canfleet::test::AllocationCount(), before);
   // First round: 2 timeouts on, 0x40 off, boot-up on/off; later rounds also 0x41 off.
   EXPECT_EQ(sink.calls, 5 + 100 * 6);
 }

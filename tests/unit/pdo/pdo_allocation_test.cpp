@@ -1,36 +1,8 @@
 // The PDO hot path does not allocate (CONTRIBUTING: re-arming a Timer does not allocate; the PDO
 // mapping is resolved to SubObject pointers once per configuration change). Counts every
 // operator new of this test binary while frames, SYNCs, events and timers run.
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
+#include "tests/support/allocation_counter.hpp"
 #include "tests/unit/pdo/pdo_fixture.hpp"
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return operator new(size);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace canfleet::canopen::test_pdo {
 namespace {
@@ -72,10 +44,10 @@ TEST_F(PdoAllocationTest, HotPathDoesNotAllocate) {
     scheduler.Advance(5ms);
   };
   round();  // warm-up: the scheduler's heap reaches its size
-  const auto before = g_allocations.load();
+  const auto before = canfleet::test::AllocationCount();
   for (int i = 0; i < 100; ++i)
     round();
-  EXPECT_EQ(g_allocations.load() - before, 0u);
+  EXPECT_EQ(canfleet::test::AllocationCount() - before, 0u);
   EXPECT_GT(port.sent, 300u);
   EXPECT_EQ(fast.Counters().rpdo_applied, 202u);
 }
