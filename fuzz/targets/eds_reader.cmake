@@ -1,0 +1,1 @@
+canfleet_fuzz_target(eds_reader DEPS canfleet_canopen_eds)
