@@ -12,6 +12,7 @@ packages=(
   clang libclang-rt-14-dev clang-format
   python3 python3-venv can-utils
   qemu-system-x86 busybox-static cpio
+  tshark
 )
 
 missing=()
@@ -23,5 +24,7 @@ done
 sudo=""
 [ "$(id -u)" -ne 0 ] && sudo="sudo"
 echo "install-deps: installing ${missing[*]}"
+# tshark asks whether non-root users may capture; answer no so the install never prompts.
+echo "wireshark-common wireshark-common/install-setuid boolean false" | $sudo debconf-set-selections
 $sudo apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

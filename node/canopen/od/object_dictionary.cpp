@@ -15,6 +15,18 @@ std::uint32_t SubObject::BitLength() const {
   return size ? static_cast<std::uint32_t>(*size * 8) : 0;
 }
 
+SubObject MakeSubObject(std::string name, DataType type, Access access, Bytes default_value,
+                        bool pdo_mappable) {
+  SubObject sub;
+  sub.name = std::move(name);
+  sub.type = type;
+  sub.access = access;
+  sub.pdo_mappable = pdo_mappable;
+  sub.default_value = default_value;
+  sub.value = std::move(default_value);
+  return sub;
+}
+
 Object& ObjectDictionary::Add(Object object) {
   for (auto& [sub_index, sub] : object.subs) {
     sub.index = object.index;
@@ -30,16 +42,9 @@ SubObject& ObjectDictionary::AddVar(std::uint16_t index, std::string name, DataT
                                     Bytes default_value, bool pdo_mappable) {
   Object obj;
   obj.index = index;
-  obj.name = name;
+  obj.name = name;  // copied: the sub-object takes the original
   obj.code = ObjectCode::kVar;
-  SubObject sub;
-  sub.name = std::move(name);
-  sub.type = type;
-  sub.access = access;
-  sub.pdo_mappable = pdo_mappable;
-  sub.default_value = default_value;
-  sub.value = std::move(default_value);
-  obj.subs.emplace(0, std::move(sub));
+  obj.subs.emplace(0, MakeSubObject(std::move(name), type, access, std::move(default_value), pdo_mappable));
   return Add(std::move(obj)).subs.at(0);
 }
 

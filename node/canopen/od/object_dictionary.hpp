@@ -58,6 +58,11 @@ struct SubObject {
   std::uint32_t BitLength() const;
 };
 
+/// A sub-object with its current value set to its default (sub-index and index are filled in
+/// by ObjectDictionary::Add).
+SubObject MakeSubObject(std::string name, DataType type, Access access, Bytes default_value,
+                        bool pdo_mappable = false);
+
 /// One object: VAR, ARRAY or RECORD (DOMAIN/DEFTYPE/DEFSTRUCT are kept for EDS round trips).
 struct Object {
   std::uint16_t index = 0;

@@ -8,16 +8,6 @@ namespace canfleet::canopen {
 
 namespace {
 
-SubObject MakeSub(std::string name, DataType type, Access access, Bytes default_value) {
-  SubObject sub;
-  sub.name = std::move(name);
-  sub.type = type;
-  sub.access = access;
-  sub.default_value = default_value;
-  sub.value = std::move(default_value);
-  return sub;
-}
-
 // Pre-defined connection set (CiA 301, facts §1): function codes of PDOs 1–4.
 constexpr std::array<std::uint32_t, 4> kRpdoFunctionCodes{0x200, 0x300, 0x400, 0x500};
 constexpr std::array<std::uint32_t, 4> kTpdoFunctionCodes{0x180, 0x280, 0x380, 0x480};
@@ -31,9 +21,9 @@ void AddPdo(ObjectDictionary& od, bool transmit, std::size_t number) {
   comm.name = kind + " communication parameter " + std::to_string(number);
   comm.code = ObjectCode::kRecord;
   const std::uint8_t highest = transmit ? 6 : 5;
-  comm.subs.emplace(0,
-                    MakeSub("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {highest}));
-  SubObject cob_id = MakeSub("COB-ID used by " + kind, DataType::kUnsigned32, Access::kRw, {});
+  comm.subs.emplace(
+      0, MakeSubObject("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {highest}));
+  SubObject cob_id = MakeSubObject("COB-ID used by " + kind, DataType::kUnsigned32, Access::kRw, {});
   if (number <= 4) {
     const auto& codes = transmit ? kTpdoFunctionCodes : kRpdoFunctionCodes;
     cob_id.default_value = EncodeLe<std::uint32_t>(kPdoCobIdNoRtr | codes[number - 1]);
@@ -44,24 +34,25 @@ void AddPdo(ObjectDictionary& od, bool transmit, std::size_t number) {
   cob_id.value = cob_id.default_value;
   comm.subs.emplace(1, std::move(cob_id));
   comm.subs.emplace(
-      2, MakeSub("Transmission type", DataType::kUnsigned8, Access::kRw, {kTransmissionEventProfile}));
-  comm.subs.emplace(3,
-                    MakeSub("Inhibit time", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0)));
-  comm.subs.emplace(4, MakeSub("Compatibility entry", DataType::kUnsigned8, Access::kRw, {0}));
-  comm.subs.emplace(5,
-                    MakeSub("Event timer", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0)));
-  if (transmit) comm.subs.emplace(6, MakeSub("SYNC start value", DataType::kUnsigned8, Access::kRw, {0}));
+      2, MakeSubObject("Transmission type", DataType::kUnsigned8, Access::kRw, {kTransmissionEventProfile}));
+  comm.subs.emplace(
+      3, MakeSubObject("Inhibit time", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0)));
+  comm.subs.emplace(4, MakeSubObject("Compatibility entry", DataType::kUnsigned8, Access::kRw, {0}));
+  comm.subs.emplace(
+      5, MakeSubObject("Event timer", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0)));
+  if (transmit)
+    comm.subs.emplace(6, MakeSubObject("SYNC start value", DataType::kUnsigned8, Access::kRw, {0}));
   od.Add(std::move(comm));
 
   Object mapping;
   mapping.index = static_cast<std::uint16_t>((transmit ? kTpdoMappingBase : kRpdoMappingBase) + offset);
   mapping.name = kind + " mapping parameter " + std::to_string(number);
   mapping.code = ObjectCode::kRecord;
-  mapping.subs.emplace(
-      0, MakeSub("Number of mapped application objects in PDO", DataType::kUnsigned8, Access::kRw, {0}));
+  mapping.subs.emplace(0, MakeSubObject("Number of mapped application objects in PDO", DataType::kUnsigned8,
+                                        Access::kRw, {0}));
   for (std::uint8_t i = 1; i <= kDefaultMappingEntries; ++i) {
-    mapping.subs.emplace(i, MakeSub("Application object " + std::to_string(i), DataType::kUnsigned32,
-                                    Access::kRw, EncodeLe<std::uint32_t>(0)));
+    mapping.subs.emplace(i, MakeSubObject("Application object " + std::to_string(i), DataType::kUnsigned32,
+                                          Access::kRw, EncodeLe<std::uint32_t>(0)));
   }
   od.Add(std::move(mapping));
 }

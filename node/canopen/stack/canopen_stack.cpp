@@ -34,7 +34,6 @@ CanopenStack::CanopenStack(ObjectDictionary& od, BusPort& port, Scheduler& sched
                            StackHooks hooks, std::shared_ptr<const ErrorPolicy> policy)
     : od_(od),
       port_(port),
-      scheduler_(scheduler),
       options_(std::move(options)),
       hooks_(std::move(hooks)),
       policy_(policy ? std::move(policy) : std::make_shared<ErrorPolicy>()),

@@ -99,7 +99,6 @@ class CanopenStack final : private CommErrorSink {
   // Declaration order is construction order: the store is read before the node-ID is chosen.
   ObjectDictionary& od_;
   BusPort& port_;
-  Scheduler& scheduler_;
   StackOptions options_;
   StackHooks hooks_;
   std::shared_ptr<const ErrorPolicy> policy_;

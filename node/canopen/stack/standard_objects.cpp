@@ -10,20 +10,6 @@
 
 namespace canfleet::canopen {
 
-namespace {
-
-SubObject MakeSub(std::string name, DataType type, Access access, Bytes value) {
-  SubObject s;
-  s.name = std::move(name);
-  s.type = type;
-  s.access = access;
-  s.default_value = value;
-  s.value = std::move(value);
-  return s;
-}
-
-}  // namespace
-
 void AddIdentityObjects(ObjectDictionary& od, const StandardObjectsOptions& o) {
   od.AddVar(0x1000, "Device type", DataType::kUnsigned32, Access::kRo, EncodeLe(o.device_type));
   od.AddVar(0x1008, "Manufacturer device name", DataType::kVisibleString, Access::kConst,
@@ -36,15 +22,16 @@ void AddIdentityObjects(ObjectDictionary& od, const StandardObjectsOptions& o) {
   identity.index = 0x1018;
   identity.name = "Identity object";
   identity.code = ObjectCode::kRecord;
-  identity.subs.emplace(0, MakeSub("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {4}));
   identity.subs.emplace(
-      1, MakeSub("Vendor-ID", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.vendor_id)));
+      0, MakeSubObject("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {4}));
   identity.subs.emplace(
-      2, MakeSub("Product code", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.product_code)));
+      1, MakeSubObject("Vendor-ID", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.vendor_id)));
+  identity.subs.emplace(2, MakeSubObject("Product code", DataType::kUnsigned32, Access::kRo,
+                                         EncodeLe(o.identity.product_code)));
   identity.subs.emplace(
-      3, MakeSub("Revision number", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.revision)));
+      3, MakeSubObject("Revision number", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.revision)));
   identity.subs.emplace(
-      4, MakeSub("Serial number", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.serial)));
+      4, MakeSubObject("Serial number", DataType::kUnsigned32, Access::kRo, EncodeLe(o.identity.serial)));
   od.Add(std::move(identity));
 }
 
@@ -54,11 +41,11 @@ void AddErrorBehaviourObject(ObjectDictionary& od, std::uint8_t entries) {
   behaviour.name = "Error behaviour";
   behaviour.code = ObjectCode::kArray;
   behaviour.subs.emplace(
-      0, MakeSub("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {entries}));
+      0, MakeSubObject("Highest sub-index supported", DataType::kUnsigned8, Access::kConst, {entries}));
   for (std::uint8_t i = 1; i <= entries; ++i) {
     // CiA 301 §7.5.2.32: 0 = pre-operational on error (the default), 1 = no change, 2 = stopped.
-    auto sub = MakeSub(i == 1 ? "Communication error" : "Error class " + std::to_string(i),
-                       DataType::kUnsigned8, Access::kRw, {0});
+    auto sub = MakeSubObject(i == 1 ? "Communication error" : "Error class " + std::to_string(i),
+                             DataType::kUnsigned8, Access::kRw, {0});
     sub.high_limit = Bytes{2};
     behaviour.subs.emplace(i, std::move(sub));
   }
