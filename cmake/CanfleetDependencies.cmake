@@ -9,8 +9,11 @@ find_package(CLI11 REQUIRED)
 find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)
 if(NOT TARGET asio::asio)
   add_library(asio::asio INTERFACE IMPORTED)
+  # ASIO_DISABLE_STD_ALIGNED_ALLOC: Asio picks aligned_alloc or operator new depending on which
+  # standard headers a file happened to include first; two choices in one program make ASan
+  # report alloc-dealloc mismatches. One choice everywhere.
   set_target_properties(asio::asio PROPERTIES INTERFACE_INCLUDE_DIRECTORIES ${ASIO_INCLUDE_DIR}
-                                              INTERFACE_COMPILE_DEFINITIONS ASIO_STANDALONE)
+                                              INTERFACE_COMPILE_DEFINITIONS "ASIO_STANDALONE;ASIO_DISABLE_STD_ALIGNED_ALLOC")
   target_link_libraries(asio::asio INTERFACE Threads::Threads)
 endif()
 

@@ -1,0 +1,1 @@
+canfleet_fuzz_target(socketcand_parser DEPS canfleet_socketcand)

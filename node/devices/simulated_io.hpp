@@ -1,0 +1,149 @@
+#pragma once
+/// @file Simulated I/O (design decision 5): every device variant declares named inputs that a test
+/// (later the control API) sets and named outputs it reads, with units in the name
+/// ("AIN1.voltage_mV", "FIN2.frequency_Hz", "POUT1.current_mA", "POUT2.load" = open|short|nominal).
+///
+/// Values are typed: a number (with a unit and an inclusive range), a bool, or one of an enum's
+/// names. Setting an input checks the name, the direction, the type and the range and says what is
+/// wrong in one line; nothing is changed then. Every declared input starts at a default inside
+/// its normal range, so an idle node raises no faults. Listeners hear every change of any signal
+/// (an input set to a new value, an output the device moved), for telemetry.
+///
+/// Threading: like the rest of a node, used from the node's event-loop thread only.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace canfleet::devices {
+
+enum class IoDirection : std::uint8_t {
+  kInput,   ///< set by a test or the control API, read by the device
+  kOutput,  ///< set by the device, read by a test or telemetry
+};
+
+enum class IoKind : std::uint8_t { kNumber, kBool, kEnum };
+
+/// A signal value: a number, a bool, or the name of one of an enum's choices.
+using IoValue = std::variant<double, bool, std::string>;
+
+/// How a signal is declared.
+struct IoSpec {
+  std::string name;  ///< "<CHANNEL>.<quantity>[_<unit>]", e.g. "AIN1.voltage_mV"
+  IoKind kind = IoKind::kNumber;
+  std::string unit;                  ///< numbers only, e.g. "mV"; empty for bool and enum
+  double min = 0;                    ///< numbers: inclusive range an input accepts
+  double max = 0;                    ///< (outputs are not range-checked)
+  std::vector<std::string> choices;  ///< enums: the accepted names
+  IoValue initial;                   ///< the power-on value; inputs: inside the normal range
+  std::string description;           ///< one line for listings
+};
+
+/// Declaration helpers: NumberSpec("AIN1.voltage_mV", "mV", 0, 36000, 2500, "voltage at the pin").
+IoSpec NumberSpec(std::string name, std::string unit, double min, double max, double initial,
+                  std::string description);
+IoSpec BoolSpec(std::string name, bool initial, std::string description);
+IoSpec EnumSpec(std::string name, std::vector<std::string> choices, std::string initial,
+                std::string description);
+
+/// One declared signal. The device keeps a reference (signals never move) and reads it on its
+/// tick; outputs are written through SimulatedIo::Publish so that listeners hear the change.
+class IoSignal {
+ public:
+  const IoSpec& spec() const { return spec_; }
+  const std::string& name() const { return spec_.name; }
+  IoDirection direction() const { return direction_; }
+  IoKind kind() const { return spec_.kind; }
+
+  const IoValue& value() const { return value_; }
+  /// The value as a number (bool: 0/1, enum: the index of the choice).
+  double Number() const;
+  bool Bool() const;
+  /// The enum choice ("" for other kinds).
+  std::string_view Enum() const;
+  /// True when this enum signal currently holds `choice`.
+  bool Is(std::string_view choice) const { return Enum() == choice; }
+  /// "2500 mV", "true", "open".
+  std::string ToString() const;
+
+ private:
+  friend class SimulatedIo;
+  IoSignal(IoSpec spec, IoDirection direction);
+  IoSpec spec_;
+  IoDirection direction_;
+  IoValue value_;
+};
+
+/// The result of setting an input: empty error = done.
+struct [[nodiscard]] IoStatus {
+  std::string error;
+  bool ok() const { return error.empty(); }
+};
+
+/// The named signals of one device.
+class SimulatedIo {
+ public:
+  using Listener = std::function<void(const IoSignal&)>;
+
+  SimulatedIo() = default;
+  SimulatedIo(const SimulatedIo&) = delete;
+  SimulatedIo& operator=(const SimulatedIo&) = delete;
+
+  // ---- Device side --------------------------------------------------------------------------
+  /// Declares an input. Names are unique; a duplicate or malformed declaration is a programming
+  /// error and throws std::logic_error (devices declare their signals once, at construction).
+  IoSignal& AddInput(IoSpec spec);
+  /// Declares an output.
+  IoSignal& AddOutput(IoSpec spec);
+  /// Sets an output (the device's view of its pins). Listeners run if the value changed.
+  void Publish(IoSignal& output, IoValue value);
+  /// Puts every input back to its declared initial value (a device reset does not do this: the
+  /// world outside the device does not reset with it; tests may).
+  void ResetInputs();
+
+  // ---- Test / control side ------------------------------------------------------------------
+  /// Sets an input; checks name, direction, kind and range (numbers) or choice (enums).
+  IoStatus Set(std::string_view name, const IoValue& value);
+  IoStatus SetNumber(std::string_view name, double value) { return Set(name, IoValue{value}); }
+  IoStatus SetBool(std::string_view name, bool value) { return Set(name, IoValue{value}); }
+  IoStatus SetEnum(std::string_view name, std::string_view choice) {
+    return Set(name, IoValue{std::string(choice)});
+  }
+  /// Parses `text` for the signal's kind ("2500", "true"/"false"/"on"/"off"/"1"/"0", "open") and
+  /// sets it: the entry point for command lines and the control API.
+  IoStatus SetText(std::string_view name, std::string_view text);
+
+  /// The signal, or null.
+  const IoSignal* Find(std::string_view name) const;
+  /// Typed reads for tests. Throw std::out_of_range for an unknown name (a typo in a test should
+  /// fail loudly).
+  double Number(std::string_view name) const;
+  bool Bool(std::string_view name) const;
+  std::string Enum(std::string_view name) const;
+
+  /// Every signal in declaration order.
+  const std::vector<std::unique_ptr<IoSignal>>& Signals() const { return signals_; }
+
+  /// Registers a change listener; returns a handle for Unsubscribe.
+  std::size_t Subscribe(Listener listener);
+  void Unsubscribe(std::size_t handle);
+
+ private:
+  IoSignal& Add(IoSpec spec, IoDirection direction);
+  const IoSignal& Get(std::string_view name) const;
+  void Store(IoSignal& signal, IoValue value);
+
+  std::vector<std::unique_ptr<IoSignal>> signals_;
+  std::map<std::string, IoSignal*, std::less<>> by_name_;
+  std::map<std::size_t, Listener> listeners_;
+  std::size_t next_handle_ = 1;
+};
+
+}  // namespace canfleet::devices

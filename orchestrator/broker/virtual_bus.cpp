@@ -1,0 +1,600 @@
+#include "orchestrator/broker/virtual_bus.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace canfleet::broker::detail {
+
+namespace {
+
+constexpr std::uint32_t kMinBitrate = 10'000;
+constexpr std::uint32_t kMaxBitrate = 1'000'000;
+/// The shortest transfer: base format, DLC 0, no stuff bit (34 + tail 10 + intermission 3).
+constexpr double kShortestTransferBits = 47;
+
+BusConfig Validated(BusConfig config) {
+  if (config.name.empty()) throw std::invalid_argument("bus name must not be empty");
+  if (config.bitrate < kMinBitrate || config.bitrate > kMaxBitrate)
+    throw std::invalid_argument("bus " + config.name + ": bitrate " + std::to_string(config.bitrate) +
+                                " outside 10000..1000000 bit/s");
+  if (config.tx_queue_capacity == 0)
+    throw std::invalid_argument("bus " + config.name + ": TX queue capacity must be at least 1");
+  if (config.stats_window <= Duration::zero())
+    throw std::invalid_argument("bus " + config.name + ": statistics window must be positive");
+  return config;
+}
+
+/// Enough records for a full window of the shortest transfers (paced); a fixed ring on an unpaced
+/// bus, whose rate has no upper bound (the figures then cover the most recent records).
+std::size_t LogCapacity(const BusConfig& config) {
+  constexpr std::size_t kUnpaced = std::size_t{1} << 16;
+  constexpr double kMax = static_cast<double>(std::size_t{1} << 22);
+  if (!config.paced) return kUnpaced;
+  const double window_bits = std::chrono::duration<double>(config.stats_window).count() * config.bitrate;
+  return static_cast<std::size_t>(std::min(window_bits / kShortestTransferBits + 16, kMax));
+}
+
+/// What the wire carries: bytes beyond the DLC are not part of a frame (and a remote frame has
+/// none), so they are cleared and captures of the same traffic are byte-identical.
+CanFrame Normalized(const CanFrame& in) {
+  CanFrame f = in;
+  const std::size_t used = f.remote() ? 0 : f.dlc;
+  std::fill(f.data.begin() + static_cast<std::ptrdiff_t>(used), f.data.end(), std::uint8_t{0});
+  return f;
+}
+
+}  // namespace
+
+template <class Change>
+auto VirtualBus::WithRound(Change&& change) {
+  if (in_round_) return change();
+  in_round_ = true;
+  // Catch up to now, but start no transfer at now before the change: a control action at an
+  // instant applies before the arbitration at that instant (a port forced bus-off together with
+  // a Submit sends nothing).
+  Process(Now(), /*start_at_now=*/false);
+  auto result = change();
+  FlushAll();
+  in_round_ = false;
+  Sweep();
+  Arm();
+  return result;
+}
+
+VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
+    : scheduler_(scheduler),
+      config_(Validated(std::move(config))),
+      created_(Now()),
+      faults_(
+          scheduler,
+          [this](PortId id) {
+            Port* port = Find(id);
+            if (port == nullptr)
+              throw std::invalid_argument("port " + std::to_string(id) + " is not on bus " + config_.name);
+            return ForceBusOff(*port);
+          }),
+      timer_(scheduler, [this] { OnTimer(); }),
+      free_at_(created_),
+      log_(LogCapacity(config_)) {
+  delayed_.reserve(256);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ports
+
+Port& VirtualBus::Attach(PortId id, std::string name, PortSink& sink, AttachOptions options) {
+  auto port = std::make_unique<Port>(id, std::move(name), sink, options, Now(), config_.tx_queue_capacity);
+  port->rx.reserve(64);
+  port->tx.reserve(64);
+  port->events.reserve(4);
+  Port& ref = *port;
+  ports_.push_back(std::move(port));
+  // A new port acknowledges: unpaced ports waiting after an ACK error may try again.
+  for (auto& p : ports_)
+    p->ack_blocked = false;
+  if (!in_round_) Arm();
+  return ref;
+}
+
+void VirtualBus::Detach(Port& port) {
+  WithRound([&] {
+    // A transfer of this port already on the wire completes (its receivers get it); nothing more
+    // reaches the port. Its outbox is discarded by the flush.
+    port.detached = true;
+    port.sink = nullptr;
+    port.queue.clear();
+    ++port.queue_epoch;
+    if (port.recover_at) {
+      port.recover_at.reset();
+      --pending_recoveries_;
+    }
+    sweep_needed_ = true;
+    return 0;
+  });
+}
+
+std::size_t VirtualBus::Submit(Port& port, std::span<const CanFrame> frames) {
+  const BusTime now = Now();
+  std::size_t accepted = 0;
+  for (const CanFrame& frame : frames) {
+    if (!frame.valid() || frame.error() || port.options.listen_only || port.detached) {
+      ++port.invalid_drops;
+      continue;
+    }
+    // A bus-off controller takes no part in bus activity (ISO 11898-1:2015 §6.15).
+    if (port.controller.State() == ControllerState::kBusOff) {
+      ++port.bus_off_drops;
+      continue;
+    }
+    if (!port.queue.push_back({Normalized(frame), now, next_seq_, false})) {
+      ++port.queue_drops;
+      ++queue_drops_;
+      continue;
+    }
+    ++next_seq_;
+    ++accepted;
+  }
+  // Wake the bus. Not inside a round (it re-arms when it ends), not when the timer already fires
+  // by now, and on a paced bus not while a transfer is on the wire (its end is armed and no frame
+  // can start before it).
+  if (accepted == 0 || in_round_) return accepted;
+  if (timer_.Armed() && timer_.Deadline() <= TimePoint(now)) return accepted;
+  if (!config_.paced)
+    timer_.StartAt(TimePoint(now));
+  else if (!in_flight_)
+    Arm();
+  return accepted;
+}
+
+bool VirtualBus::RecoverBusOff(Port& port) {
+  return WithRound([&] {
+    if (port.detached || port.controller.State() != ControllerState::kBusOff) return false;
+    Recover(port);
+    return true;
+  });
+}
+
+bool VirtualBus::ForceBusOff(Port& port) {
+  return WithRound([&] {
+    if (port.detached) return false;
+    auto event = port.controller.ForceBusOff();
+    if (!event) return false;
+    Emit(port, event);
+    EnterBusOff(port, Now());
+    return true;
+  });
+}
+
+Port* VirtualBus::Find(PortId id) const {
+  for (const auto& p : ports_)
+    if (p->id == id && !p->detached) return p.get();
+  return nullptr;
+}
+
+std::vector<const Port*> VirtualBus::Ports() const {
+  std::vector<const Port*> out;
+  for (const auto& p : ports_)
+    if (!p->detached) out.push_back(p.get());
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rounds
+
+void VirtualBus::OnTimer() {
+  Run();
+}
+
+void VirtualBus::Run() {
+  // Inside a round (a sink drove the scheduler), the running round re-arms when it ends.
+  if (in_round_) return;
+  in_round_ = true;
+  const BusTime now = Now();
+  last_round_ = now;
+  Process(now, /*start_at_now=*/true);
+  FlushAll();
+  in_round_ = false;
+  Sweep();
+  Arm();
+}
+
+bool VirtualBus::Eligible(const Port& port) const {
+  return !port.detached && !port.queue.empty() && port.controller.State() != ControllerState::kBusOff &&
+         (config_.paced || !port.ack_blocked);
+}
+
+Port* VirtualBus::OldestHead() const {
+  Port* oldest = nullptr;
+  for (const auto& p : ports_) {
+    if (!Eligible(*p)) continue;
+    if (oldest == nullptr || p->queue.front().seq < oldest->queue.front().seq) oldest = p.get();
+  }
+  return oldest;
+}
+
+std::optional<BusTime> VirtualBus::NextStart() const {
+  if (!config_.paced) {
+    const Port* oldest = OldestHead();
+    if (oldest == nullptr) return std::nullopt;
+    return oldest->queue.front().submitted;
+  }
+  // A frame joins the first arbitration that starts at or after both its submission and the end
+  // of its port's suspend-transmission time; the bus starts one as soon as it is idle and some
+  // frame is ready ("a message pending during a transfer starts at the first bit after
+  // intermission", ISO 11898-1:2015 §10.4 interframe space).
+  std::optional<BusTime> earliest;
+  for (const auto& p : ports_) {
+    if (!Eligible(*p)) continue;
+    const BusTime ready = std::max(p->queue.front().submitted, p->ready_at);
+    if (!earliest || ready < *earliest) earliest = ready;
+  }
+  if (!earliest) return std::nullopt;
+  return std::max(*earliest, free_at_);
+}
+
+Port* VirtualBus::Arbitrate(BusTime start) const {
+  // Every port offers the head of its FIFO queue (as a CAN driver with one TX buffer does);
+  // the lowest arbitration key wins. Two ports sending the same identifier at once is a
+  // configuration error on a real bus; here the earlier submission wins.
+  Port* winner = nullptr;
+  std::uint32_t best_key = 0;
+  std::uint64_t best_seq = 0;
+  for (const auto& p : ports_) {
+    if (!Eligible(*p)) continue;
+    const QueuedFrame& head = p->queue.front();
+    if (std::max(head.submitted, p->ready_at) > start) continue;
+    const std::uint32_t key = ArbitrationKey(head.frame);
+    if (winner == nullptr || key < best_key || (key == best_key && head.seq < best_seq)) {
+      winner = p.get();
+      best_key = key;
+      best_seq = head.seq;
+    }
+  }
+  return winner;
+}
+
+bool VirtualBus::HasAcknowledger(const Port& transmitter, BusTime start) const {
+  // Any other controller that is not bus-off acknowledges a valid frame, error-passive ones too
+  // (ISO 11898-1:2015 §6.10); a listen-only port never drives the bus.
+  for (const auto& p : ports_) {
+    if (p.get() == &transmitter || p->detached || p->options.listen_only || !AttachedBy(*p, start)) continue;
+    if (p->controller.State() != ControllerState::kBusOff) return true;
+  }
+  return false;
+}
+
+TransferOutcome VirtualBus::Outcome(Port& transmitter, const CanFrame& frame, BusTime start) {
+  if (!faults_.Empty() && faults_.CorruptAttempt(transmitter.id, frame, start))
+    return TransferOutcome::kCrcError;
+  if (!HasAcknowledger(transmitter, start)) return TransferOutcome::kAckError;
+  return TransferOutcome::kOk;
+}
+
+void VirtualBus::Process(BusTime now, bool start_at_now) {
+  enum class Kind : std::uint8_t { kNone, kComplete, kRecover, kDelayed, kStart };
+  for (;;) {
+    // The earliest event; on equal times the order below: a transfer ends, then recoveries and
+    // delayed deliveries happen, then the next arbitration starts.
+    Kind kind = Kind::kNone;
+    BusTime at{};
+    auto consider = [&](BusTime t, Kind k) {
+      if (kind == Kind::kNone || t < at) {
+        kind = k;
+        at = t;
+      }
+    };
+    if (in_flight_) consider(in_flight_->end, Kind::kComplete);
+    Port* recovering = nullptr;
+    if (pending_recoveries_ > 0) {
+      for (const auto& p : ports_)
+        if (p->recover_at && (recovering == nullptr || *p->recover_at < *recovering->recover_at))
+          recovering = p.get();
+      if (recovering != nullptr) consider(*recovering->recover_at, Kind::kRecover);
+    }
+    if (!delayed_.empty()) consider(delayed_.front().due, Kind::kDelayed);
+    std::optional<BusTime> start;
+    if (!in_flight_) {
+      start = NextStart();
+      if (start) consider(*start, Kind::kStart);
+    }
+    if (kind == Kind::kNone || at > now) return;
+    if (kind == Kind::kStart && at == now && !start_at_now) return;
+
+    switch (kind) {
+      case Kind::kComplete: {
+        const InFlight transfer = *in_flight_;
+        in_flight_.reset();
+        Complete(transfer);
+        break;
+      }
+      case Kind::kRecover:
+        Recover(*recovering);
+        break;
+      case Kind::kDelayed: {
+        std::pop_heap(delayed_.begin(), delayed_.end(), DueLater);
+        const Delayed delayed = delayed_.back();
+        delayed_.pop_back();
+        DeliverDelayed(delayed);
+        break;
+      }
+      case Kind::kStart: {
+        if (config_.paced) {
+          Port* winner = Arbitrate(*start);
+          const QueuedFrame& head = winner->queue.front();
+          const TransferOutcome outcome = Outcome(*winner, head.frame, *start);
+          const BusTime end = *start + BitTime(AttemptBits(head.frame, outcome), config_.bitrate);
+          in_flight_ = InFlight{winner, head, winner->queue_epoch, *start, end, outcome};
+        } else {
+          // No time line: the oldest submission goes, taking no time.
+          Port* winner = OldestHead();
+          const QueuedFrame head = winner->queue.front();
+          const TransferOutcome outcome = Outcome(*winner, head.frame, head.submitted);
+          // A lone unpaced port would retry forever in zero time: it waits for another port.
+          if (outcome == TransferOutcome::kAckError) winner->ack_blocked = true;
+          Complete({winner, head, winner->queue_epoch, head.submitted, head.submitted, outcome});
+        }
+        break;
+      }
+      case Kind::kNone:
+        return;
+    }
+  }
+}
+
+void VirtualBus::Complete(const InFlight& transfer) {
+  Port& tx = *transfer.port;
+  const CanFrame& frame = transfer.entry.frame;
+  if (config_.paced) free_at_ = transfer.end;
+  const bool ok = transfer.outcome == TransferOutcome::kOk;
+  log_.Record(transfer.start, transfer.end, frame, !ok);
+  // The transmitter may have been detached or forced bus-off while its frame was on the wire:
+  // the frame still completes for the receivers, but the transmitter's side is gone.
+  const bool tx_live =
+      !tx.detached && tx.queue_epoch == transfer.epoch && tx.controller.State() != ControllerState::kBusOff;
+  auto receives = [&](const Port& p) {
+    return !p.detached && AttachedBy(p, transfer.start) && p.controller.State() != ControllerState::kBusOff;
+  };
+
+  if (ok) {
+    ++frames_;
+    const bool faults = !faults_.Empty();
+    const bool repeat =
+        faults && faults_.EvaluateDelivery(tx.id, frame, transfer.start, transfer.entry.repetition);
+    const TimedFrame timed{frame, transfer.end};
+    for (std::size_t i = 0; i < ports_.size(); ++i) {
+      Port& rx = *ports_[i];
+      if (&rx == &tx || !receives(rx)) continue;
+      const FaultStage::Decision decision = faults ? faults_.ForReceiver(rx.id) : FaultStage::Decision{};
+      switch (decision.kind) {
+        case FaultStage::Decision::kDeliver:
+          rx.rx.push_back(timed);
+          ++rx.rx_frames;
+          ++deliveries_;
+          break;
+        case FaultStage::Decision::kDrop:
+          ++rx.fault_drops;
+          ++fault_drops_;
+          break;
+        case FaultStage::Decision::kDelay:
+          delayed_.push_back({transfer.end + decision.delay, delay_seq_++, rx.id, frame});
+          std::push_heap(delayed_.begin(), delayed_.end(), DueLater);
+          ++fault_delays_;
+          break;
+      }
+      // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8).
+      if (!rx.options.listen_only) Emit(rx, rx.controller.OnReceiveSuccess());
+    }
+    if (faults) faults_.EndOfTransfer(transfer.start);
+    if (tx_live) {
+      ++tx.tx_frames;
+      if (!transfer.entry.repetition) tx.tx.push_back(timed);
+      if (repeat)
+        tx.queue.front().repetition = true;  // stays at the head: sent once more
+      else
+        tx.queue.pop_front();
+      // Successful transmission: TEC − 1 (rule 7).
+      Emit(tx, tx.controller.OnTransmitSuccess());
+      SuspendIfPassive(tx, transfer.end);
+    }
+    return;
+  }
+
+  ++error_frames_;
+  CanFrame error_frame;
+  error_frame.id = frame.id;
+  error_frame.flags = static_cast<std::uint8_t>(CanFrame::kError | (frame.flags & CanFrame::kExtended));
+  for (std::size_t i = 0; i < ports_.size(); ++i) {
+    Port& p = *ports_[i];
+    if (p.options.error_frames && receives(p)) p.rx.push_back({error_frame, transfer.end});
+  }
+  if (tx_live) {
+    // Transmit error: TEC + 8 (rule 3), except an ACK error of an error-passive transmitter
+    // (rule 3, exception 1): a lone node stops at error-passive. The frame stays queued and is
+    // retransmitted automatically (ISO 11898-1:2015 §6.11).
+    ++tx.tx_errors;
+    Emit(tx, tx.controller.OnTransmitError(
+                 transfer.outcome == TransferOutcome::kAckError ? TransmitError::kAck : TransmitError::kBit));
+    if (tx.controller.State() == ControllerState::kBusOff)
+      EnterBusOff(tx, transfer.end);
+    else
+      SuspendIfPassive(tx, transfer.end);
+  }
+  if (transfer.outcome == TransferOutcome::kCrcError) {
+    // Every receiver detects the error: REC + 1 (rule 1).
+    for (std::size_t i = 0; i < ports_.size(); ++i) {
+      Port& rx = *ports_[i];
+      if (&rx == &tx || rx.options.listen_only || !receives(rx)) continue;
+      ++rx.rx_errors;
+      Emit(rx, rx.controller.OnReceiveError());
+    }
+  }
+}
+
+void VirtualBus::DeliverDelayed(const Delayed& delayed) {
+  Port* rx = Find(delayed.receiver);
+  if (rx == nullptr || rx->controller.State() == ControllerState::kBusOff) return;
+  rx->rx.push_back({delayed.frame, delayed.due});
+  ++rx->rx_frames;
+  ++deliveries_;
+}
+
+void VirtualBus::Recover(Port& port) {
+  if (port.recover_at) {
+    port.recover_at.reset();
+    --pending_recoveries_;
+  }
+  Emit(port, port.controller.Recover());
+}
+
+void VirtualBus::EnterBusOff(Port& port, BusTime at) {
+  // A bus-off node's pending frames are not sent: the queue is dropped (counted).
+  port.bus_off_drops += port.queue.size();
+  port.queue.clear();
+  ++port.queue_epoch;
+  port.ready_at = BusTime{};
+  // Recovery after 128 occurrences of 11 consecutive recessive bits (ISO 11898-1:2015 §12.1.4.2),
+  // counted as 1408 bit times from the end of the error frame that caused the bus-off.
+  if (config_.auto_recover && !port.recover_at) {
+    port.recover_at = at + BitTime(kBusOffRecoveryBits, config_.bitrate);
+    ++pending_recoveries_;
+  }
+}
+
+void VirtualBus::SuspendIfPassive(Port& port, BusTime end) {
+  if (config_.paced && port.controller.State() == ControllerState::kErrorPassive)
+    port.ready_at = end + BitTime(kSuspendTransmissionBits, config_.bitrate);
+}
+
+void VirtualBus::Emit(Port& port, const std::optional<ControllerEvent>& event) {
+  if (event) port.events.push_back({port.rx.size(), port.tx.size(), *event});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Timer and delivery
+
+std::optional<BusTime> VirtualBus::NextEvent() const {
+  std::optional<BusTime> next;
+  auto consider = [&](BusTime t) {
+    if (!next || t < *next) next = t;
+  };
+  if (in_flight_) {
+    consider(in_flight_->end);
+  } else if (auto start = NextStart()) {
+    // Unpaced: frames submitted during a round go in a round at least 1 ns later on the
+    // scheduler's time line, so two sinks answering each other cannot spin forever at one
+    // instant of simulated time (real time: the next turn of the event loop).
+    if (!config_.paced && last_round_) start = std::max(*start, *last_round_ + BusTime(1));
+    consider(*start);
+  }
+  if (!delayed_.empty()) consider(delayed_.front().due);
+  if (pending_recoveries_ > 0)
+    for (const auto& p : ports_)
+      if (p->recover_at) consider(*p->recover_at);
+  return next;
+}
+
+void VirtualBus::Arm() {
+  const auto next = NextEvent();
+  if (!next) {
+    timer_.Cancel();
+    return;
+  }
+  const TimePoint at(*next);
+  if (!timer_.Armed() || timer_.Deadline() != at) timer_.StartAt(at);
+}
+
+void VirtualBus::FlushAll() {
+  // Sinks may cause new controller events (a forced bus-off from inside a callback) or attach
+  // ports: repeat until every outbox is empty. Index loops: ports_ may grow meanwhile.
+  bool again = true;
+  while (again) {
+    again = false;
+    for (std::size_t i = 0; i < ports_.size(); ++i) {
+      Port& port = *ports_[i];
+      if (!port.HasOutbox()) continue;
+      FlushPort(port);
+      again = true;
+    }
+  }
+}
+
+void VirtualBus::FlushPort(Port& port) {
+  // rx and tx do not change while sinks run (nothing is processed inside a round's flush), so the
+  // spans stay valid; events may be appended (the loop re-reads the size).
+  std::size_t rx_done = 0;
+  std::size_t tx_done = 0;
+  auto frames_up_to = [&](std::size_t rx_mark, std::size_t tx_mark) {
+    if (rx_mark > rx_done) {
+      if (port.sink != nullptr)
+        port.sink->Deliver(std::span<const TimedFrame>(port.rx).subspan(rx_done, rx_mark - rx_done));
+      rx_done = rx_mark;
+    }
+    if (tx_mark > tx_done) {
+      if (port.sink != nullptr)
+        port.sink->TxConfirmed(std::span<const TimedFrame>(port.tx).subspan(tx_done, tx_mark - tx_done));
+      tx_done = tx_mark;
+    }
+  };
+  for (std::size_t e = 0; e < port.events.size(); ++e) {
+    const Port::PendingEvent pending = port.events[e];
+    frames_up_to(pending.rx_mark, pending.tx_mark);
+    if (port.sink != nullptr) port.sink->ControllerChanged(pending.event);
+  }
+  frames_up_to(port.rx.size(), port.tx.size());
+  port.rx.clear();
+  port.tx.clear();
+  port.events.clear();
+}
+
+void VirtualBus::Sweep() {
+  if (!sweep_needed_) return;
+  const Port* on_wire = in_flight_ ? in_flight_->port : nullptr;
+  std::erase_if(ports_,
+                [on_wire](const std::unique_ptr<Port>& p) { return p->detached && p.get() != on_wire; });
+  sweep_needed_ = on_wire != nullptr && on_wire->detached;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statistics
+
+BusStats VirtualBus::Stats(std::size_t top_ids) const {
+  BusStats s;
+  s.name = config_.name;
+  s.bitrate = config_.bitrate;
+  s.paced = config_.paced;
+  s.ports = Ports().size();
+  s.time = Now();
+  std::optional<TransmissionLog::Ongoing> ongoing;
+  if (in_flight_) ongoing = TransmissionLog::Ongoing{in_flight_->start, in_flight_->end};
+  log_.Summarize(s.time, config_.stats_window, created_, ongoing, top_ids, s);
+  if (!config_.paced) s.load_percent = 0;
+  s.frames = frames_;
+  s.error_frames = error_frames_;
+  s.deliveries = deliveries_;
+  s.queue_drops = queue_drops_;
+  s.fault_drops = fault_drops_;
+  s.fault_delays = fault_delays_;
+  return s;
+}
+
+PortStats VirtualBus::StatsOf(const Port& port) const {
+  PortStats s;
+  s.id = port.id;
+  s.bus = config_.name;
+  s.name = port.name;
+  s.controller = port.controller.Snapshot();
+  s.queued = port.queue.size();
+  s.tx_frames = port.tx_frames;
+  s.rx_frames = port.rx_frames;
+  s.tx_errors = port.tx_errors;
+  s.rx_errors = port.rx_errors;
+  s.queue_drops = port.queue_drops;
+  s.invalid_drops = port.invalid_drops;
+  s.bus_off_drops = port.bus_off_drops;
+  s.fault_drops = port.fault_drops;
+  return s;
+}
+
+}  // namespace canfleet::broker::detail

@@ -1,0 +1,171 @@
+#pragma once
+/// @file One virtual bus: the ports on it, arbitration, the time line, error confinement, the
+/// fault stage and delivery. Internal to the broker (Broker is the public face).
+///
+/// The bus is a discrete-event simulation driven by one Timer. Every event has a bus time:
+/// end of a transfer, start of the next arbitration, a delayed delivery falling due, a bus-off
+/// recovery. When the timer fires (on time in simulated time, late in real time), the bus
+/// processes every event whose time is ≤ now in time order, back to back, then hands each port
+/// one batch. Because every decision is taken from bus times (a frame joins an arbitration only if
+/// it was submitted by its start), batching never changes the order or the timestamps.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bus/fault_confinement.hpp"
+#include "clock/scheduler.hpp"
+#include "orchestrator/broker/bus_config.hpp"
+#include "orchestrator/broker/fault_stage.hpp"
+#include "orchestrator/broker/port_sink.hpp"
+#include "orchestrator/broker/stats.hpp"
+#include "orchestrator/broker/transmission_log.hpp"
+#include "orchestrator/broker/tx_queue.hpp"
+#include "orchestrator/broker/wire_model.hpp"
+
+namespace canfleet::broker::detail {
+
+struct Port {
+  Port(PortId port_id, std::string port_name, PortSink& port_sink, AttachOptions port_options,
+       BusTime attached, std::size_t queue_capacity)
+      : id(port_id),
+        name(std::move(port_name)),
+        sink(&port_sink),
+        options(port_options),
+        attached_at(attached),
+        queue(queue_capacity) {}
+
+  PortId id;
+  std::string name;
+  PortSink* sink;  ///< nullptr once detached
+  AttachOptions options;
+  BusTime attached_at;  ///< transfers that started before this are not received
+  bool detached = false;
+
+  TxQueue queue;
+  std::uint32_t queue_epoch = 0;  ///< bumped whenever the queue is dropped (bus-off, detach)
+  FaultConfinement controller;
+  BusTime ready_at{};                 ///< suspend transmission: may not start a transfer before
+  std::optional<BusTime> recover_at;  ///< automatic bus-off recovery due
+  bool ack_blocked = false;           ///< unpaced: head got an ACK error, wait for another port
+
+  // Outbox of the current round: frames, confirmations and controller events, in bus order.
+  struct PendingEvent {
+    std::size_t rx_mark;  ///< rx frames that precede the event
+    std::size_t tx_mark;
+    ControllerEvent event;
+  };
+  std::vector<TimedFrame> rx;
+  std::vector<TimedFrame> tx;
+  std::vector<PendingEvent> events;
+  bool HasOutbox() const { return !rx.empty() || !tx.empty() || !events.empty(); }
+
+  std::uint64_t tx_frames = 0, rx_frames = 0, tx_errors = 0, rx_errors = 0;
+  std::uint64_t queue_drops = 0, invalid_drops = 0, bus_off_drops = 0, fault_drops = 0;
+};
+
+class VirtualBus {
+ public:
+  /// Throws std::invalid_argument on a bitrate outside 10k..1M, an empty queue or window.
+  VirtualBus(Scheduler& scheduler, BusConfig config);
+  VirtualBus(const VirtualBus&) = delete;
+  VirtualBus& operator=(const VirtualBus&) = delete;
+
+  const BusConfig& Config() const { return config_; }
+
+  Port& Attach(PortId id, std::string name, PortSink& sink, AttachOptions options);
+  void Detach(Port& port);
+  std::size_t Submit(Port& port, std::span<const CanFrame> frames);
+  bool RecoverBusOff(Port& port);
+  bool ForceBusOff(Port& port);
+
+  FaultStage& Faults() { return faults_; }
+  BusStats Stats(std::size_t top_ids) const;
+  PortStats StatsOf(const Port& port) const;
+  /// The attached ports, in attach order.
+  std::vector<const Port*> Ports() const;
+
+ private:
+  struct InFlight {
+    Port* port;
+    QueuedFrame entry;
+    std::uint32_t epoch;
+    BusTime start;
+    BusTime end;
+    TransferOutcome outcome;
+  };
+  struct Delayed {
+    BusTime due;
+    std::uint64_t seq;
+    PortId receiver;
+    CanFrame frame;
+  };
+  /// Heap order of delayed deliveries: earliest due first, then in the order they were delayed.
+  static bool DueLater(const Delayed& a, const Delayed& b) {
+    return a.due != b.due ? a.due > b.due : a.seq > b.seq;
+  }
+
+  BusTime Now() const { return scheduler_.Now().time_since_epoch(); }
+
+  void OnTimer();
+  /// Processes, flushes, sweeps and re-arms, unless a round is already running.
+  void Run();
+  /// Runs `change` inside a round at Now(): the bus first catches up to Now(), the outboxes are
+  /// flushed after. Nested calls (from a sink) just run `change`; the running round flushes.
+  template <class Change>
+  auto WithRound(Change&& change);
+
+  /// Handles every event due by `now` in time order. `start_at_now`: whether a transfer may
+  /// start at `now` itself (false while catching up before a control action).
+  void Process(BusTime now, bool start_at_now);
+  bool Eligible(const Port& port) const;
+  std::optional<BusTime> NextStart() const;
+  Port* Arbitrate(BusTime start) const;
+  Port* OldestHead() const;
+  /// Whether `port` was on the bus when a transfer started at `start` (a port that attaches
+  /// mid-frame missed its start of frame). Unpaced buses have no time line: every attached port.
+  bool AttachedBy(const Port& port, BusTime start) const {
+    return !config_.paced || port.attached_at <= start;
+  }
+  bool HasAcknowledger(const Port& transmitter, BusTime start) const;
+  TransferOutcome Outcome(Port& transmitter, const CanFrame& frame, BusTime start);
+  void Complete(const InFlight& transfer);
+  void DeliverDelayed(const Delayed& delayed);
+  void Recover(Port& port);
+  void EnterBusOff(Port& port, BusTime at);
+  void SuspendIfPassive(Port& port, BusTime end);
+  void Emit(Port& port, const std::optional<ControllerEvent>& event);
+  std::optional<BusTime> NextEvent() const;
+  void Arm();
+  void FlushAll();
+  void FlushPort(Port& port);
+  void Sweep();
+  Port* Find(PortId id) const;
+
+  Scheduler& scheduler_;
+  BusConfig config_;
+  BusTime created_;
+  FaultStage faults_;
+  Timer timer_;
+
+  std::vector<std::unique_ptr<Port>> ports_;
+  std::optional<InFlight> in_flight_;
+  BusTime free_at_{};  ///< end of the last transfer (intermission included): the bus is idle from then
+  std::vector<Delayed> delayed_;  ///< min-heap on (due, seq)
+  std::size_t pending_recoveries_ = 0;
+  std::uint64_t next_seq_ = 0;
+  std::uint64_t delay_seq_ = 0;
+  std::optional<BusTime> last_round_;  ///< when the timer last ran a round
+  bool in_round_ = false;
+  bool sweep_needed_ = false;
+
+  TransmissionLog log_;
+  std::uint64_t frames_ = 0, error_frames_ = 0, deliveries_ = 0;
+  std::uint64_t queue_drops_ = 0, fault_drops_ = 0, fault_delays_ = 0;
+};
+
+}  // namespace canfleet::broker::detail

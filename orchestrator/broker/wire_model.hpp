@@ -1,0 +1,77 @@
+#pragma once
+/// @file What the broker needs to know about a CAN wire beyond bus/frame_timing.hpp: who wins
+/// arbitration, how long a failed transfer occupies the bus, and how long an error-passive
+/// transmitter must wait before it may send again. All lengths are in bit times.
+
+#include <cstdint>
+
+#include "bus/can_frame.hpp"
+#include "bus/frame_timing.hpp"
+
+namespace canfleet::broker {
+
+/// The arbitration field of `frame` as a 32-bit number whose order is the wire's order: of two
+/// frames, the one with the smaller key wins arbitration (ISO 11898-1:2015 §6.3 bus access method;
+/// arbitration field of §10.4: dominant 0 overwrites recessive 1, so the first differing bit decides).
+///
+/// Bits, most significant first, as transmitted after SOF:
+///
+///     31..21  base identifier (ID-28..ID-18; the whole 11-bit identifier of a base frame)
+///     20      RTR of a base frame, SRR (always recessive) of an extended frame
+///     19      IDE: dominant (0) for a base frame, recessive (1) for an extended frame
+///     18..1   identifier extension (ID-17..ID-0), 0 for a base frame
+///     0       RTR of an extended frame, 0 for a base frame
+///
+/// Consequences: a data frame beats a remote frame with the same identifier (RTR); a base-format
+/// data frame beats an extended frame with the same base identifier (RTR dominant vs SRR
+/// recessive); a base-format remote frame still beats it (IDE). A base frame's arbitration ends at
+/// IDE, so its bits 18..0 are 0 and two base frames that tie there are the same identifier.
+constexpr std::uint32_t ArbitrationKey(const CanFrame& frame) {
+  const std::uint32_t rtr = (frame.flags & CanFrame::kRemote) != 0 ? 1U : 0U;
+  if ((frame.flags & CanFrame::kExtended) != 0) {
+    const std::uint32_t base = (frame.id >> 18) & 0x7FFU;
+    const std::uint32_t extension = frame.id & 0x3FFFFU;
+    return base << 21 | 1U << 20 | 1U << 19 | extension << 1 | rtr;
+  }
+  return (frame.id & 0x7FFU) << 21 | rtr << 20;
+}
+
+/// A transfer that ends in an ACK error: the transmitter sees no dominant ACK slot and starts its
+/// error flag at the next bit (ISO 11898-1:2015 §6.10 ACK, §6.9 error signalling). After the stuffed
+/// region: CRC delimiter 1, ACK slot 1, error flag 6, error delimiter 8, intermission 3.
+inline constexpr std::uint32_t kAckErrorTailBits = 1 + 1 + 6 + 8 + 3;
+
+/// A transfer destroyed by a CRC error (the broker's model of a corrupted frame): receivers start
+/// their error flag at the bit after the ACK delimiter (ISO 11898-1:2015 §6.8 error detection, §6.9
+/// error signalling). After the stuffed region: CRC delimiter 1,
+/// ACK slot 1, ACK delimiter 1, error flag 6, error delimiter 8, intermission 3. Superposed error
+/// flags (up to 12 bits when nodes detect the error at different bits) are not modelled.
+inline constexpr std::uint32_t kCrcErrorTailBits = 1 + 1 + 1 + 6 + 8 + 3;
+
+/// After transmitting a frame, an error-passive node sends 8 recessive bits (suspend transmission)
+/// following the intermission before it may start another transfer; other nodes may start in the
+/// meantime (ISO 11898-1:2015 §10.4, interframe space: suspend transmission; §6.14 error-passive).
+inline constexpr std::uint32_t kSuspendTransmissionBits = 8;
+
+/// How a transfer ended on the wire.
+enum class TransferOutcome : std::uint8_t {
+  kOk,        ///< acknowledged, valid for everyone
+  kAckError,  ///< nobody acknowledged (the transmitter is alone on the bus)
+  kCrcError,  ///< destroyed by an error frame (fault injection)
+};
+
+/// Bus occupancy of one transfer attempt of `frame`, including the intermission that follows it.
+inline std::uint32_t AttemptBits(const CanFrame& frame, TransferOutcome outcome) {
+  const FrameBits bits = CountFrameBits(frame);
+  switch (outcome) {
+    case TransferOutcome::kAckError:
+      return bits.unstuffed + bits.stuff + kAckErrorTailBits;
+    case TransferOutcome::kCrcError:
+      return bits.unstuffed + bits.stuff + kCrcErrorTailBits;
+    case TransferOutcome::kOk:
+      break;
+  }
+  return bits.total();
+}
+
+}  // namespace canfleet::broker

@@ -1,0 +1,122 @@
+#include "orchestrator/socketcand/server.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <asio/error.hpp>
+#include <asio/ip/address.hpp>
+#include <asio/ip/tcp.hpp>
+#include <asio/steady_timer.hpp>
+#include <stdexcept>
+
+#include "orchestrator/socketcand/session.hpp"
+
+namespace canfleet::socketcand {
+namespace detail {
+
+struct Listener : std::enable_shared_from_this<Listener> {
+  Listener(std::shared_ptr<Context> c, std::string b)
+      : ctx(std::move(c)), bus(std::move(b)), acceptor(ctx->io), retry(ctx->io) {}
+
+  void Accept();
+  void OnAccept(const asio::error_code& ec, asio::ip::tcp::socket socket);
+  void Close() {
+    retry.cancel();
+    asio::error_code ec;
+    acceptor.close(ec);
+  }
+
+  std::shared_ptr<Context> ctx;
+  std::string bus;
+  asio::ip::tcp::acceptor acceptor;
+  asio::steady_timer retry;  ///< after a failed accept (out of file descriptors...)
+};
+
+void Listener::Accept() {
+  acceptor.async_accept(
+      [self = shared_from_this()](const asio::error_code& ec, asio::ip::tcp::socket socket) {
+        self->OnAccept(ec, std::move(socket));
+      });
+}
+
+void Listener::OnAccept(const asio::error_code& ec, asio::ip::tcp::socket socket) {
+  if (ctx->stopped || ec == asio::error::operation_aborted) return;
+  if (ec) {
+    // Typically EMFILE: retry later instead of spinning on a listener that keeps failing.
+    spdlog::warn("socketcand {}: accept failed: {}; retrying in 100 ms", bus, ec.message());
+    retry.expires_after(std::chrono::milliseconds(100));
+    retry.async_wait([self = shared_from_this()](const asio::error_code& timer_ec) {
+      if (!timer_ec && !self->ctx->stopped) self->Accept();
+    });
+    return;
+  }
+  auto& sessions = ctx->sessions;
+  sessions.erase(std::remove_if(sessions.begin(), sessions.end(), [](const auto& s) { return s->closed(); }),
+                 sessions.end());
+  auto session = std::make_shared<Session>(ctx, std::move(socket), bus);
+  sessions.push_back(session);
+  ++ctx->stats.sessions_accepted;
+  ++ctx->stats.sessions_open;
+  session->Start();
+  Accept();
+}
+
+}  // namespace detail
+
+Server::Server(asio::io_context& io, broker::Broker& broker, const Scheduler& scheduler,
+               ServerOptions options)
+    : context_(std::make_shared<detail::Context>(io, broker, std::move(options))) {
+  if (context_->options.wall_origin) {
+    context_->origin = *context_->options.wall_origin;
+  } else {
+    const auto now = std::chrono::time_point_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now());
+    context_->origin = now - scheduler.Now().time_since_epoch();
+  }
+}
+
+Server::~Server() {
+  Stop();
+}
+
+std::uint16_t Server::Serve(std::string_view bus, std::optional<std::uint16_t> port) {
+  const auto buses = context_->broker.Buses();
+  if (std::find(buses.begin(), buses.end(), bus) == buses.end())
+    throw std::invalid_argument("socketcand: unknown bus " + std::string(bus));
+  if (context_->Serves(bus))
+    throw std::invalid_argument("socketcand: bus " + std::string(bus) + " is already served");
+  const std::uint16_t wanted = port.value_or(static_cast<std::uint16_t>(kDefaultPort + listeners_.size()));
+
+  auto listener = std::make_shared<detail::Listener>(context_, std::string(bus));
+  const asio::ip::tcp::endpoint endpoint(asio::ip::make_address(context_->options.bind_address), wanted);
+  listener->acceptor.open(endpoint.protocol());
+  listener->acceptor.set_option(asio::ip::tcp::acceptor::reuse_address(true));
+  listener->acceptor.bind(endpoint);
+  listener->acceptor.listen();
+  const std::uint16_t bound = listener->acceptor.local_endpoint().port();
+
+  context_->stopped = false;
+  context_->buses.emplace_back(bus);
+  listeners_.push_back(listener);
+  listener->Accept();
+  spdlog::info("socketcand: serving {} on {}:{}", bus, context_->options.bind_address, bound);
+  return bound;
+}
+
+void Server::Stop() {
+  if (context_->stopped) return;
+  context_->stopped = true;
+  for (auto& l : listeners_)
+    l->Close();
+  listeners_.clear();
+  context_->buses.clear();
+  auto sessions = std::move(context_->sessions);
+  context_->sessions.clear();
+  for (auto& s : sessions)
+    s->Close("server stopped");
+}
+
+ServerStats Server::Stats() const {
+  return context_->stats;
+}
+
+}  // namespace canfleet::socketcand
