@@ -31,7 +31,13 @@ int CompareNumeric(DataType type, std::span<const std::uint8_t> a, std::span<con
 std::string FormatValue(DataType type, std::span<const std::uint8_t> bytes) {
   char buf[64];
   if (type == DataType::kVisibleString) {
-    return "\"" + std::string(bytes.begin(), bytes.end()) + "\"";
+    // Appended piecewise: GCC 12 at -O3 reports a false -Wrestrict inside string operator+ (PR 105651).
+    std::string out;
+    out.reserve(bytes.size() + 2);
+    out.push_back('"');
+    out.append(bytes.begin(), bytes.end());
+    out.push_back('"');
+    return out;
   }
   if (IsVariableLength(type)) {
     std::string out;
