@@ -1,0 +1,388 @@
+#include "bus/broker_client/broker_client_port.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <asio/connect.hpp>
+#include <asio/generic/stream_protocol.hpp>
+#include <asio/ip/tcp.hpp>
+#include <asio/local/stream_protocol.hpp>
+#include <asio/post.hpp>
+#include <asio/steady_timer.hpp>
+#include <asio/write.hpp>
+#include <stdexcept>
+
+#include "bus/wire/endpoint.hpp"
+#include "bus/wire/message_writer.hpp"
+#include "bus/wire/stream_decoder.hpp"
+
+namespace canfleet {
+
+namespace {
+
+/// Bytes asked of the socket per read: many batches at once under load.
+constexpr std::size_t kReadChunk = 64 * 1024;
+
+asio::mutable_buffer Buffer(std::span<std::uint8_t> s) {
+  return {s.data(), s.size()};
+}
+asio::const_buffer Buffer(std::span<const std::uint8_t> s) {
+  return {s.data(), s.size()};
+}
+
+long long Ms(std::chrono::milliseconds d) {
+  return static_cast<long long>(d.count());
+}
+
+}  // namespace
+
+/// The connection state machine. Owned through a shared_ptr so that every pending Asio handler
+/// keeps it alive ([this, self] captures, style.md "Asio lifetimes"); the port only points to it
+/// and detaches itself (owner_ = nullptr) when destroyed. Each connection attempt has a
+/// generation number: completions of an older socket are ignored.
+class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
+ public:
+  Link(asio::io_context& io, BrokerClientPort& owner, BrokerClientOptions options)
+      : io_(io),
+        owner_(&owner),
+        options_(std::move(options)),
+        endpoint_(wire::Endpoint::Parse(options_.endpoint)),
+        socket_(io),
+        resolver_(io),
+        timer_(io),
+        backoff_(options_.initial_backoff) {}
+
+  void Start() {
+    asio::post(io_, [this, self = shared_from_this()] { Connect(); });
+  }
+
+  void Shutdown() {
+    owner_ = nullptr;
+    phase_ = Phase::kStopped;
+    ++generation_;
+    CloseSocket();
+    timer_.cancel();
+    resolver_.cancel();
+  }
+
+  bool Send(const CanFrame& frame) {
+    if (phase_ != Phase::kConnected || options_.monitor || !frame.valid() || frame.error() ||
+        state_ == ControllerState::kBusOff || filling_.frame_count() >= options_.transmit_queue_frames) {
+      ++stats_.tx_refused;
+      return false;
+    }
+    filling_.AddFrame(frame);
+    ++stats_.tx_frames;
+    ScheduleFlush();
+    return true;
+  }
+
+  ControllerState State() const { return state_; }
+  bool Connected() const { return phase_ == Phase::kConnected; }
+  std::optional<BrokerSession> Session() const {
+    return Connected() ? std::optional(session_) : std::nullopt;
+  }
+  const BrokerClientStats& Stats() const { return stats_; }
+
+  ConnectionHandler on_connection;
+  TxConfirmHandler on_tx_confirmed;
+
+ private:
+  enum class Phase : std::uint8_t { kIdle, kConnecting, kHandshake, kConnected, kWaiting, kStopped };
+
+  void Connect() {
+    if (phase_ == Phase::kStopped) return;
+    phase_ = Phase::kConnecting;
+    const std::uint64_t gen = ++generation_;
+    spdlog::debug("connecting to broker at {}", endpoint_.ToString());
+    timer_.expires_after(options_.handshake_timeout);
+    timer_.async_wait([this, self = shared_from_this(), gen](const asio::error_code& ec) {
+      if (ec || gen != generation_) return;
+      Fail("no HelloReply within " + std::to_string(Ms(options_.handshake_timeout)) + " ms");
+    });
+    if (endpoint_.kind == wire::Endpoint::Kind::kUnix) {
+      socket_.async_connect(asio::local::stream_protocol::endpoint(endpoint_.path),
+                            [this, self = shared_from_this(), gen](const asio::error_code& ec) {
+                              if (gen == generation_) OnConnected(ec);
+                            });
+      return;
+    }
+    resolver_.async_resolve(
+        endpoint_.host, std::to_string(endpoint_.port),
+        [this, self = shared_from_this(), gen](const asio::error_code& ec,
+                                               const asio::ip::tcp::resolver::results_type& results) {
+          if (gen != generation_) return;
+          if (ec || results.empty()) {
+            Fail("cannot resolve " + endpoint_.host + ": " + (ec ? ec.message() : "no address"));
+            return;
+          }
+          const asio::generic::stream_protocol::endpoint target(results.begin()->endpoint());
+          socket_.async_connect(target, [this, self, gen](const asio::error_code& connect_ec) {
+            if (gen == generation_) OnConnected(connect_ec);
+          });
+        });
+  }
+
+  void OnConnected(const asio::error_code& ec) {
+    if (ec) {
+      Fail(ec.message());
+      return;
+    }
+    if (endpoint_.kind == wire::Endpoint::Kind::kTcp) {
+      asio::error_code ignored;
+      socket_.set_option(asio::ip::tcp::no_delay(true), ignored);  // a batch is complete when written
+    }
+    phase_ = Phase::kHandshake;
+    wire::Hello hello = wire::MakeHello(options_.bus, options_.node_name, options_.node_id,
+                                        options_.monitor ? wire::ROLE_MONITOR : wire::ROLE_NODE);
+    hello.set_tx_confirmations(options_.tx_confirmations);
+    filling_.AddHello(hello);
+    Flush();
+    Read();
+  }
+
+  void Read() {
+    const std::uint64_t gen = generation_;
+    socket_.async_read_some(
+        Buffer(decoder_.WritableSpace(kReadChunk)),
+        [this, self = shared_from_this(), gen](const asio::error_code& ec, std::size_t n) {
+          if (gen != generation_) return;
+          if (ec) {
+            Fail(ec == asio::error::eof ? "the broker closed the connection" : ec.message());
+            return;
+          }
+          ++stats_.reads;
+          decoder_.Commit(n);
+          for (;;) {
+            const auto result = decoder_.Next(message_);
+            if (result == wire::StreamDecoder::Result::kNeedMore) break;
+            if (result == wire::StreamDecoder::Result::kError) {
+              ProtocolError("malformed data from the broker: " + decoder_.Error());
+              return;
+            }
+            Handle(message_);
+            if (gen != generation_) return;  // the handler failed or destroyed the port
+          }
+          Read();
+        });
+  }
+
+  void Handle(const wire::Message& m) {
+    if (phase_ == Phase::kHandshake) {
+      if (m.type == wire::MessageType::kHelloReply) {
+        OnHelloReply(m.envelope.hello_reply());
+      } else if (m.type == wire::MessageType::kError) {
+        Fail("the broker closed the connection: " + m.envelope.error().reason());
+      } else {
+        ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " before HelloReply");
+      }
+      return;
+    }
+    switch (m.type) {
+      case wire::MessageType::kFrames:
+        stats_.rx_frames += m.frames.size();
+        for (std::size_t i = 0; i < m.frames.size(); ++i) {
+          const wire::StampedFrame f = m.frames[i];
+          owner_->Deliver(f.frame, f.time);
+          if (owner_ == nullptr) return;
+        }
+        return;
+      case wire::MessageType::kTxConfirm:
+        for (std::size_t i = 0; i < m.frames.size() && on_tx_confirmed; ++i) {
+          const wire::StampedFrame f = m.frames[i];
+          on_tx_confirmed(f.frame, f.time);
+          if (owner_ == nullptr) return;
+        }
+        return;
+      case wire::MessageType::kControllerEvent:
+        state_ = m.controller.state;
+        owner_->NotifyState(m.controller);
+        return;
+      case wire::MessageType::kPing:
+        filling_.AddPong(m.envelope.ping().nonce());
+        ScheduleFlush();
+        return;
+      case wire::MessageType::kPong:
+        return;
+      case wire::MessageType::kError:
+        Fail("the broker closed the connection: " + m.envelope.error().reason());
+        return;
+      case wire::MessageType::kHello:
+      case wire::MessageType::kHelloReply:
+        ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from the broker");
+        return;
+    }
+  }
+
+  void OnHelloReply(const wire::HelloReply& reply) {
+    if (!reply.accepted()) {
+      spdlog::error("broker at {} refused bus {}: {}", endpoint_.ToString(), options_.bus, reply.reason());
+      const std::string detail = "refused: " + reply.reason();
+      Fail(detail);
+      // Unlike an absent broker, a refusal may never go away (protocol version, unknown bus): the
+      // node process is told, so it can give up. The port keeps retrying unless destroyed.
+      if (on_connection) on_connection(false, detail);
+      return;
+    }
+    timer_.cancel();
+    phase_ = Phase::kConnected;
+    backoff_ = options_.initial_backoff;
+    session_ = {reply.port_id(), reply.bitrate(), reply.mode() != wire::BUS_MODE_UNPACED};
+    ++stats_.connects;
+    const std::string detail =
+        endpoint_.ToString() + " bus " + options_.bus + " (" + std::to_string(session_.bitrate) + " bit/s, " +
+        (session_.paced ? "paced" : "unpaced") + "), port " + std::to_string(session_.port_id);
+    spdlog::info("connected to broker at {}", detail);
+    const std::uint64_t gen = generation_;
+    if (state_ != ControllerState::kErrorActive) {
+      // A new attachment is a new controller (error-active, counters 0).
+      state_ = ControllerState::kErrorActive;
+      owner_->NotifyState({ControllerState::kErrorActive, 0, 0});
+      if (gen != generation_) return;
+    }
+    if (on_connection) on_connection(true, detail);
+  }
+
+  /// The peer broke the protocol: say why (best effort), then drop the connection.
+  void ProtocolError(const std::string& reason) {
+    spdlog::error("protocol error from broker at {}: {}", endpoint_.ToString(), reason);
+    if (socket_.is_open()) {
+      // Written synchronously past any queued data is not possible mid-write; only when idle.
+      if (!write_in_flight_) {
+        wire::MessageWriter error;
+        error.AddError(reason);
+        asio::error_code ignored;
+        socket_.non_blocking(true, ignored);
+        socket_.write_some(Buffer(error.Bytes()), ignored);
+      }
+    }
+    Fail(reason);
+  }
+
+  void Fail(const std::string& reason) {
+    if (phase_ == Phase::kStopped) return;
+    const bool was_connected = phase_ == Phase::kConnected;
+    ++generation_;
+    CloseSocket();
+    timer_.cancel();
+    resolver_.cancel();
+    phase_ = Phase::kWaiting;
+    const auto delay = backoff_;
+    backoff_ = std::min(backoff_ * 2, options_.max_backoff);
+    if (was_connected) {
+      ++stats_.disconnects;
+      spdlog::warn("broker connection lost: {}; reconnecting in {} ms", reason, Ms(delay));
+    } else {
+      ++stats_.failed_attempts;
+      spdlog::warn("cannot attach to broker at {}: {}; retrying in {} ms", endpoint_.ToString(), reason,
+                   Ms(delay));
+    }
+    const std::uint64_t gen = generation_;
+    timer_.expires_after(delay);
+    timer_.async_wait([this, self = shared_from_this(), gen](const asio::error_code& ec) {
+      if (!ec && gen == generation_) Connect();
+    });
+    if (was_connected && on_connection) on_connection(false, reason);
+  }
+
+  void CloseSocket() {
+    asio::error_code ignored;
+    socket_.shutdown(asio::socket_base::shutdown_both, ignored);
+    socket_.close(ignored);
+    // Pending operations were cancelled with the socket: the buffers are free again.
+    write_in_flight_ = false;
+    filling_.Clear();
+    writing_.Clear();
+    decoder_ = wire::StreamDecoder();
+  }
+
+  void ScheduleFlush() {
+    if (flush_posted_ || write_in_flight_) return;
+    flush_posted_ = true;
+    asio::post(io_, [this, self = shared_from_this()] {
+      flush_posted_ = false;
+      Flush();
+    });
+  }
+
+  /// Writes everything appended so far in one write; what is appended meanwhile waits for it.
+  void Flush() {
+    if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
+    filling_.Swap(writing_);
+    write_in_flight_ = true;
+    ++stats_.writes;
+    const std::uint64_t gen = generation_;
+    asio::async_write(socket_, Buffer(writing_.Bytes()),
+                      [this, self = shared_from_this(), gen](const asio::error_code& ec, std::size_t) {
+                        if (gen != generation_) return;
+                        write_in_flight_ = false;
+                        writing_.Clear();
+                        if (ec) {
+                          Fail(ec.message());
+                          return;
+                        }
+                        Flush();
+                      });
+  }
+
+  asio::io_context& io_;
+  BrokerClientPort* owner_;
+  BrokerClientOptions options_;
+  wire::Endpoint endpoint_;
+  asio::generic::stream_protocol::socket socket_;
+  asio::ip::tcp::resolver resolver_;
+  asio::steady_timer timer_;  ///< handshake deadline, then reconnection delay
+  std::chrono::milliseconds backoff_;
+  Phase phase_ = Phase::kIdle;
+  std::uint64_t generation_ = 0;
+
+  wire::StreamDecoder decoder_;
+  wire::Message message_;
+  wire::MessageWriter filling_;  ///< appended to by Send and replies
+  wire::MessageWriter writing_;  ///< being written
+  bool write_in_flight_ = false;
+  bool flush_posted_ = false;
+
+  ControllerState state_ = ControllerState::kErrorActive;
+  BrokerSession session_;
+  BrokerClientStats stats_;
+};
+
+BrokerClientPort::BrokerClientPort(asio::io_context& io, BrokerClientOptions options)
+    : link_(std::make_shared<Link>(io, *this, std::move(options))) {
+  link_->Start();
+}
+
+BrokerClientPort::~BrokerClientPort() {
+  link_->Shutdown();
+}
+
+bool BrokerClientPort::Send(const CanFrame& frame) {
+  return link_->Send(frame);
+}
+
+ControllerState BrokerClientPort::State() const {
+  return link_->State();
+}
+
+bool BrokerClientPort::Connected() const {
+  return link_->Connected();
+}
+
+std::optional<BrokerSession> BrokerClientPort::Session() const {
+  return link_->Session();
+}
+
+void BrokerClientPort::OnConnection(ConnectionHandler handler) {
+  link_->on_connection = std::move(handler);
+}
+
+void BrokerClientPort::OnTxConfirmed(TxConfirmHandler handler) {
+  link_->on_tx_confirmed = std::move(handler);
+}
+
+const BrokerClientStats& BrokerClientPort::Stats() const {
+  return link_->Stats();
+}
+
+}  // namespace canfleet

@@ -1,0 +1,103 @@
+#pragma once
+/// @file The node's attachment to a virtual bus of the broker (design.md: "canfleet-node ...
+/// --bus can0@tcp://host:port"): a BusPort over the node <-> broker protocol (bus/wire/).
+
+#include <asio/io_context.hpp>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "bus/bus_port.hpp"
+
+namespace canfleet {
+
+struct BrokerClientOptions {
+  /// `tcp://host:port` or `unix:///path` (bus/wire/endpoint.hpp).
+  std::string endpoint = "tcp://127.0.0.1:29600";
+  std::string bus = "can0";
+  std::string node_name;      ///< for the broker's logs and statistics
+  std::uint32_t node_id = 0;  ///< CANopen node-ID, 0 when none (a tool)
+  /// Bus monitoring (a capture tool): receives every frame and error frame, never transmits or
+  /// acknowledges. Send always returns false.
+  bool monitor = false;
+  /// Ask the broker for TX confirmations (OnTxConfirmed).
+  bool tx_confirmations = false;
+  /// Reconnection delays: the first retry after `initial_backoff`, doubling up to `max_backoff`;
+  /// back to `initial_backoff` after a successful Hello.
+  std::chrono::milliseconds initial_backoff{100};
+  std::chrono::milliseconds max_backoff{5000};
+  /// Connect + Hello/HelloReply must complete within this, or the attempt counts as failed.
+  std::chrono::milliseconds handshake_timeout{5000};
+  /// Frames waiting to be written to the socket; a Send beyond this returns false.
+  std::size_t transmit_queue_frames = 65536;
+};
+
+/// What the broker told us when it accepted the Hello.
+struct BrokerSession {
+  std::uint32_t port_id = 0;
+  std::uint32_t bitrate = 0;  ///< bit/s
+  bool paced = true;
+};
+
+struct BrokerClientStats {
+  std::uint64_t connects = 0;     ///< accepted Hellos
+  std::uint64_t disconnects = 0;  ///< established connections lost
+  std::uint64_t failed_attempts = 0;
+  std::uint64_t tx_frames = 0;   ///< frames accepted by Send
+  std::uint64_t tx_refused = 0;  ///< Send returned false
+  std::uint64_t rx_frames = 0;   ///< frames delivered to OnReceive
+  std::uint64_t writes = 0;      ///< socket writes started (one per io_context turn at most)
+  std::uint64_t reads = 0;       ///< socket reads completed
+};
+
+/// A BusPort on a broker's virtual bus, over TCP or a Unix-domain socket, driven by an
+/// asio::io_context (all handlers run on the thread running it; a handler may destroy the port).
+///
+/// - Connects on construction (asynchronously) and sends Hello; frames flow once the broker
+///   accepts it.
+/// - Send appends the frame to an outgoing batch; the batch is written once per io_context turn,
+///   so a burst of frames is one write. Buffers are reused: no allocation per frame.
+/// - Received frames reach OnReceive with their bus time; controller events reach OnStateChange
+///   and State().
+/// - When the broker goes away (or refuses the Hello), the port logs why and reconnects with
+///   exponential backoff ("broker connection lost: ...; reconnecting in 400 ms"). While it is
+///   disconnected Send returns false: the frames are lost, as on an unplugged cable. Each new
+///   connection is a new controller: error-active, counters 0.
+class BrokerClientPort final : public BusPort {
+ public:
+  /// `connected`: true once a Hello is accepted; false when that connection is lost, and also when
+  /// the broker refuses the Hello (`detail` starts with "refused: "), which retrying may never cure
+  /// (protocol version, unknown bus). Failed attempts to reach an absent broker are only logged.
+  /// `detail`: "tcp://127.0.0.1:29600 bus can0 (500000 bit/s, paced), port 3" or why.
+  using ConnectionHandler = std::function<void(bool connected, const std::string& detail)>;
+  using TxConfirmHandler = std::function<void(const CanFrame&, BusTime)>;
+
+  /// Throws std::invalid_argument on a malformed endpoint.
+  BrokerClientPort(asio::io_context& io, BrokerClientOptions options);
+  ~BrokerClientPort() override;
+  BrokerClientPort(const BrokerClientPort&) = delete;
+  BrokerClientPort& operator=(const BrokerClientPort&) = delete;
+
+  /// False when disconnected, bus-off, a monitor, the frame is invalid or an error frame, or the
+  /// transmit queue is full.
+  bool Send(const CanFrame& frame) override;
+  ControllerState State() const override;
+
+  bool Connected() const;
+  /// The current connection's parameters; nullopt while disconnected.
+  std::optional<BrokerSession> Session() const;
+
+  void OnConnection(ConnectionHandler handler);
+  void OnTxConfirmed(TxConfirmHandler handler);
+
+  const BrokerClientStats& Stats() const;
+
+ private:
+  class Link;
+  std::shared_ptr<Link> link_;
+};
+
+}  // namespace canfleet

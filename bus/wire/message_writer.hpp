@@ -1,0 +1,112 @@
+#pragma once
+/// @file Encodes messages into one growing byte buffer, ready for a single write. The buffer is
+/// reused from write to write, so a steady stream of frames costs no allocation.
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "bus/wire/byte_buffer.hpp"
+#include "bus/wire/messages.hpp"
+
+namespace canfleet::wire {
+
+/// Appends length-delimited Envelopes (canfleet_wire.proto) to a buffer.
+///
+/// Frames go into an open batch: consecutive frames of the same kind extend one FrameBatch message
+/// (split every kMaxFramesPerMessage frames); any other message closes it first, so the stream
+/// keeps the order of the calls. The batch's header is reserved at its maximum size and shrunk
+/// when it is closed (one memmove of the batch), so frames are written once, in place.
+///
+/// Frames and TX confirmations are encoded by hand, byte-identical to what protobuf writes for the
+/// same Envelope (tests check it both ways); the rare control messages go through the generated
+/// code.
+class MessageWriter {
+ public:
+  MessageWriter() = default;
+
+  /// Appends one frame to the open frames batch (opening one if needed).
+  void AddFrame(const CanFrame& frame, BusTime time = BusTime::zero()) {
+    AddRecord(MessageType::kFrames, frame, time);
+  }
+  /// Appends one frame to the open TX-confirmation batch.
+  void AddTxConfirm(const CanFrame& frame, BusTime time) { AddRecord(MessageType::kTxConfirm, frame, time); }
+
+  /// Appends many frames at once (`kind`: kFrames or kTxConfirm): one size check per batch rather
+  /// than per frame. `stamp(item)` gives each item's StampedFrame.
+  template <class T, class Stamp>
+  void AddFrames(MessageType kind, std::span<const T> items, Stamp&& stamp) {
+    std::size_t done = 0;
+    while (done < items.size()) {
+      const std::size_t n = std::min(Room(kind), items.size() - done);
+      std::uint8_t* out = buffer_.Extend(n * kFrameRecordSize);
+      for (std::size_t i = 0; i < n; ++i, out += kFrameRecordSize) {
+        const StampedFrame s = stamp(items[done + i]);
+        EncodeRecord(s.frame, s.time, out);
+      }
+      batch_frames_ += n;
+      frames_ += n;
+      done += n;
+    }
+  }
+
+  void AddHello(const Hello& hello);
+  void AddHelloReply(const HelloReply& reply);
+  void AddControllerEvent(const canfleet::ControllerEvent& event);
+  void AddPing(std::uint64_t nonce);
+  void AddPong(std::uint64_t nonce);
+  void AddError(std::string_view reason);
+
+  /// Closes the open batch, if any.
+  void CloseBatch();
+
+  /// Every message appended so far (closes the open batch).
+  std::span<const std::uint8_t> Bytes() {
+    CloseBatch();
+    return buffer_.bytes();
+  }
+  /// Bytes appended so far, counting an open batch at its reserved size.
+  std::size_t size() const { return buffer_.size(); }
+  bool empty() const { return buffer_.empty(); }
+  /// Frames appended since the last Clear.
+  std::size_t frame_count() const { return frames_; }
+
+  /// Forgets every message; keeps the storage.
+  void Clear();
+
+  /// Exchanges contents with another writer (double buffering: fill one while the other is
+  /// being written).
+  void Swap(MessageWriter& other) noexcept;
+
+ private:
+  void AddRecord(MessageType kind, const CanFrame& frame, BusTime time) {
+    Room(kind);
+    EncodeRecord(frame, time, buffer_.Extend(kFrameRecordSize));
+    ++batch_frames_;
+    ++frames_;
+  }
+  /// Makes sure a batch of `kind` is open and has room; returns how many frames it can still take.
+  std::size_t Room(MessageType kind) {
+    if (batch_open_ && batch_kind_ == kind && batch_frames_ < kMaxFramesPerMessage)
+      return kMaxFramesPerMessage - batch_frames_;
+    CloseBatch();
+    OpenBatch(kind);
+    return kMaxFramesPerMessage;
+  }
+  void OpenBatch(MessageType kind);
+  /// Appends a protobuf-encoded Envelope.
+  template <class Fill>
+  void AppendProto(Fill&& fill);
+
+  ByteBuffer buffer_;
+  // The open batch: its kind, where its reserved header starts, how many frames it holds.
+  bool batch_open_ = false;
+  MessageType batch_kind_ = MessageType::kFrames;
+  std::size_t batch_start_ = 0;
+  std::size_t batch_frames_ = 0;
+  std::size_t frames_ = 0;
+};
+
+}  // namespace canfleet::wire

@@ -1,0 +1,1 @@
+canfleet_fuzz_target(wire_decoder DEPS canfleet_wire)

@@ -1,0 +1,191 @@
+// canfleet-node: one emulated CANopen device as its own process. Only wiring lives here:
+// command line → device → ports → DeviceNode → event loop.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <asio/io_context.hpp>
+#include <asio/post.hpp>
+#include <asio/signal_set.hpp>
+#include <iostream>
+#include <memory>
+
+#include "bus/broker_client/broker_client_port.hpp"
+#include "bus/socketcan/socketcan_port.hpp"
+#include "clock/asio_scheduler.hpp"
+#include "node/devices/device_node.hpp"
+#include "node/devices/registry.hpp"
+#include "node/process/node_options.hpp"
+#include "node/process/stdin_control.hpp"
+
+namespace {
+
+using namespace canfleet;
+
+constexpr const char* kVersion = "canfleet-node 0.1.0";
+
+std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spec,
+                                  const node::NodeOptions& options, std::uint8_t node_id,
+                                  std::shared_ptr<spdlog::logger> log,
+                                  std::function<void()> on_first_connect) {
+  if (spec.socketcan) {
+    auto port = std::make_unique<SocketCanPort>(io, spec.bus);
+    port->OnError([log](std::error_code ec) { log->error("socketcan: {}", ec.message()); });
+    asio::post(io, on_first_connect);
+    return port;
+  }
+  BrokerClientOptions client;
+  client.endpoint = spec.endpoint;
+  client.bus = spec.bus;
+  client.node_name = options.name;
+  client.node_id = node_id;
+  auto port = std::make_unique<BrokerClientPort>(io, client);
+  port->OnConnection(
+      [log, started = false, on_first_connect](bool connected, const std::string& detail) mutable {
+        if (connected) {
+          log->info("connected to the broker: {}", detail);
+          // Power-on happens when the cable is first plugged in: the boot-up frame must reach the bus.
+          if (!started) {
+            started = true;
+            on_first_connect();
+          }
+        } else {
+          log->warn("broker connection: {}", detail);
+        }
+      });
+  return port;
+}
+
+int Run(const node::NodeOptions& options) {
+  auto log = spdlog::stdout_color_mt(options.name);
+  log->set_level(spdlog::level::from_str(options.log_level));
+  spdlog::set_default_logger(log);
+
+  auto device = devices::MakeDevice({options.device, options.eds});
+  const std::size_t port_count = device->PortCount();
+  if (options.buses.size() != port_count) {
+    throw std::invalid_argument("--bus: device '" + std::string(device->Name()) + "' has " +
+                                std::to_string(port_count) + " CAN port(s) but " +
+                                std::to_string(options.buses.size()) + " --bus option(s) were given");
+  }
+  if (options.node_ids.size() != 1 && options.node_ids.size() != port_count) {
+    throw std::invalid_argument("--node-id: give one node-ID, or one per CAN port (" +
+                                std::to_string(port_count) + ")");
+  }
+
+  asio::io_context io;
+  AsioScheduler scheduler(io);
+  devices::NodeSettings settings;
+  settings.state_dir = options.state_dir;
+  settings.serial_number = options.serial_number;
+  settings.hooks.on_state_changed = [log](canopen::NmtState s) {
+    log->info("NMT state: {}", canopen::ToString(s));
+  };
+  settings.hooks.on_comm_error = [log](const canopen::CommError& e, bool active) {
+    log->warn("communication error {} (detail {}) {}", static_cast<int>(e.kind), e.detail,
+              active ? "raised" : "cleared");
+  };
+  settings.hooks.on_storage_issue = [log](const std::string& text) {
+    log->warn("stored parameters: {}", text);
+  };
+
+  std::unique_ptr<devices::DeviceNode> node;
+  std::size_t connected_ports = 0;
+  auto start_when_all_connected = [&] {
+    if (++connected_ports == port_count) {
+      node->Start();
+      log->info("powered on");
+    }
+  };
+  std::vector<std::unique_ptr<BusPort>> ports;
+  std::vector<BusPort*> raw_ports;
+  for (std::size_t p = 0; p < port_count; ++p) {
+    auto id = options.node_ids.size() == 1 ? options.node_ids[0] : options.node_ids[p];
+    settings.ports.push_back({id, 4});
+    ports.push_back(MakePort(io, options.buses[p], options, id, log, start_when_all_connected));
+    raw_ports.push_back(ports.back().get());
+  }
+  node = std::make_unique<devices::DeviceNode>(std::move(device), scheduler, raw_ports, settings);
+  for (const auto& assignment : options.io) {
+    auto eq = assignment.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--io " + assignment + ": expected NAME=VALUE");
+    auto status = node->io().SetText(assignment.substr(0, eq), assignment.substr(eq + 1));
+    if (!status.ok()) throw std::invalid_argument("--io " + assignment + ": " + status.error);
+  }
+
+  std::unique_ptr<node::StdinControl> control;
+  if (options.stdin_control) {
+    control = std::make_unique<node::StdinControl>(io, *node);
+    control->Start();
+  }
+  asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const asio::error_code& ec, int signal) {
+    if (!ec) log->info("signal {}: shutting down", signal);
+    io.stop();
+  });
+  log->info("{} node-ID {} on {} port(s); waiting for the bus", node->device().Name(),
+            static_cast<int>(options.node_ids[0]), port_count);
+  io.run();
+  // Destroy the node (its timers and hooks) before the ports and the scheduler it uses.
+  control.reset();
+  node.reset();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"canfleet-node: one emulated CANopen device on a virtual or real CAN bus"};
+  canfleet::node::NodeOptions options;
+  std::vector<std::string> buses;
+  std::vector<int> node_ids;
+  std::uint32_t serial = 0;
+  bool list = false, version = false;
+  app.add_option("--device", options.device, "device variant (see --list-devices)");
+  app.add_option("--eds", options.eds, "EDS file: a generic CiA 301 slave, or replaces the variant's EDS")
+      ->check(CLI::ExistingFile);
+  app.add_option("--node-id", node_ids, "node-ID 1..127, or 255 for an unconfigured LSS slave; one per port")
+      ->check(CLI::Range(1, 255));
+  app.add_option("--bus", buses, "BUS@tcp://HOST:PORT, BUS@unix:///PATH or socketcan:IFACE; one per port");
+  app.add_option("--state-dir", options.state_dir, "folder for stored parameters (1010h) and LSS settings");
+  auto* serial_opt = app.add_option("--serial", serial, "serial number (1018h sub 4)");
+  app.add_option("--name", options.name, "name in logs and on the broker (default DEVICE@ID)");
+  app.add_option("--io", options.io, "initial simulated input NAME=VALUE (repeatable)");
+  app.add_flag("--stdin-control", options.stdin_control,
+               "accept set/get/list/nmt commands on standard input");
+  app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_flag("--list-devices", list, "list the device variants and exit");
+  app.add_flag("--version", version, "print the version and exit");
+  CLI11_PARSE(app, argc, argv);
+
+  if (version) {
+    std::cout << kVersion << "\n";
+    return 0;
+  }
+  if (list) {
+    std::cout << canfleet::devices::ListDevices();
+    return 0;
+  }
+  try {
+    if (options.device.empty() && options.eds.empty()) throw std::invalid_argument("give --device or --eds");
+    if (buses.empty()) throw std::invalid_argument("give at least one --bus");
+    if (node_ids.empty()) throw std::invalid_argument("give --node-id");
+    for (const auto& b : buses)
+      options.buses.push_back(canfleet::node::ParseBusSpec(b));
+    for (int id : node_ids) {
+      if (id > 127 && id != 255)
+        throw std::invalid_argument("--node-id " + std::to_string(id) + ": 1..127 or 255");
+      options.node_ids.push_back(static_cast<std::uint8_t>(id));
+    }
+    if (*serial_opt) options.serial_number = serial;
+    if (options.name.empty()) {
+      options.name = (options.device.empty() ? options.eds.stem().string() : options.device) + "@" +
+                     std::to_string(node_ids[0]);
+    }
+    return Run(options);
+  } catch (const std::exception& e) {
+    std::cerr << "canfleet-node: " << e.what() << "\n";
+    return 2;
+  }
+}

@@ -1,0 +1,36 @@
+#pragma once
+/// @file The command line of canfleet-node, parsed and validated before anything starts.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace canfleet::node {
+
+/// Where one CAN port of the node is attached.
+struct BusSpec {
+  std::string bus;       ///< bus name on the broker ("can0"); the interface name for SocketCAN
+  std::string endpoint;  ///< "tcp://host:port" or "unix:///path"; empty for SocketCAN
+  bool socketcan = false;
+};
+
+struct NodeOptions {
+  std::string device;                  ///< --device (empty: generic node from --eds)
+  std::filesystem::path eds;           ///< --eds
+  std::vector<std::uint8_t> node_ids;  ///< --node-id, one per port or one for all
+  std::vector<BusSpec> buses;          ///< --bus, one per device port
+  std::filesystem::path state_dir;     ///< --state-dir
+  std::optional<std::uint32_t> serial_number;
+  std::string name;             ///< --name (log prefix, broker port name)
+  std::vector<std::string> io;  ///< --io NAME=VALUE initial simulated inputs
+  bool stdin_control = false;   ///< --stdin-control
+  std::string log_level = "info";
+};
+
+/// Parses "can0@tcp://127.0.0.1:29600", "can1@unix:///run/canfleet.sock" or "socketcan:vcan0".
+/// @throws std::invalid_argument naming the option and the problem.
+BusSpec ParseBusSpec(const std::string& text);
+
+}  // namespace canfleet::node

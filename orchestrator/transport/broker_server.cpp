@@ -1,0 +1,147 @@
+#include "orchestrator/transport/broker_server.hpp"
+
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <asio/generic/stream_protocol.hpp>
+#include <asio/ip/address.hpp>
+#include <asio/steady_timer.hpp>
+#include <stdexcept>
+
+#include "orchestrator/transport/session.hpp"
+#include "orchestrator/transport/unix_socket_path.hpp"
+
+namespace canfleet::transport {
+
+namespace {
+
+/// After a failed accept (e.g. out of file descriptors), wait this long before the next one
+/// instead of spinning.
+constexpr std::chrono::milliseconds kAcceptRetry{100};
+
+std::string Describe(const asio::ip::tcp::endpoint& ep) {
+  return ep.address().is_v6() ? "[" + ep.address().to_string() + "]:" + std::to_string(ep.port())
+                              : ep.address().to_string() + ":" + std::to_string(ep.port());
+}
+
+}  // namespace
+
+BrokerServer::BrokerServer(asio::io_context& io, broker::Broker& broker, ServerOptions options)
+    : io_(io), broker_(broker), options_(options) {}
+
+BrokerServer::~BrokerServer() {
+  Close();
+}
+
+wire::Endpoint BrokerServer::Listen(const wire::Endpoint& endpoint) {
+  if (closed_) throw std::logic_error("BrokerServer::Listen after Close");
+  wire::Endpoint bound = endpoint;
+  if (endpoint.kind == wire::Endpoint::Kind::kTcp) {
+    asio::ip::tcp::resolver resolver(io_);
+    // Startup only: a blocking resolve of the listen address is fine here.
+    const auto results =
+        resolver.resolve(endpoint.host, std::to_string(endpoint.port), asio::ip::tcp::resolver::passive);
+    const asio::ip::tcp::endpoint ep = results.begin()->endpoint();
+    auto acceptor = std::make_unique<asio::ip::tcp::acceptor>(io_, ep, /*reuse_address=*/true);
+    bound.port = acceptor->local_endpoint().port();
+    if (!ep.address().is_loopback())
+      spdlog::warn("listening on {}, which other hosts can reach: anyone who can connect can join the buses",
+                   bound.ToString());
+    tcp_.push_back(std::move(acceptor));
+    AcceptTcp(tcp_.size() - 1);
+  } else {
+    ClaimUnixSocketPath(endpoint.path);
+    auto acceptor = std::make_unique<asio::local::stream_protocol::acceptor>(
+        io_, asio::local::stream_protocol::endpoint(endpoint.path));
+    unix_paths_.push_back(endpoint.path);
+    unix_.push_back(std::move(acceptor));
+    AcceptUnix(unix_.size() - 1);
+  }
+  endpoints_.push_back(bound);
+  spdlog::info("listening on {}", bound.ToString());
+  return bound;
+}
+
+void BrokerServer::AcceptTcp(std::size_t index) {
+  tcp_[index]->async_accept([this, index, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec,
+                                                                              asio::ip::tcp::socket socket) {
+    if (alive.expired() || closed_) return;
+    std::string peer = "tcp";
+    asio::generic::stream_protocol::socket generic(io_);
+    if (!ec) {
+      asio::error_code ignored;
+      socket.set_option(asio::ip::tcp::no_delay(true), ignored);  // batches are whole when written
+      const auto remote = socket.remote_endpoint(ignored);
+      if (!ignored) peer = "tcp " + Describe(remote);
+      const auto protocol = socket.local_endpoint(ignored).protocol();
+      generic = asio::generic::stream_protocol::socket(
+          io_, asio::generic::stream_protocol(protocol.family(), protocol.protocol()), socket.release());
+    }
+    OnAccept(ec, std::move(peer), std::move(generic));
+    if (ec) {
+      auto timer = std::make_shared<asio::steady_timer>(io_, kAcceptRetry);
+      timer->async_wait([this, index, timer, alive](const asio::error_code& wait_ec) {
+        if (!wait_ec && !alive.expired() && !closed_) AcceptTcp(index);
+      });
+      return;
+    }
+    AcceptTcp(index);
+  });
+}
+
+void BrokerServer::AcceptUnix(std::size_t index) {
+  unix_[index]->async_accept([this, index, alive = std::weak_ptr<int>(alive_)](
+                                 const asio::error_code& ec, asio::local::stream_protocol::socket socket) {
+    if (alive.expired() || closed_) return;
+    asio::generic::stream_protocol::socket generic(io_);
+    if (!ec)
+      generic = asio::generic::stream_protocol::socket(io_, asio::generic::stream_protocol(AF_UNIX, 0),
+                                                       socket.release());
+    OnAccept(ec, "unix " + unix_paths_[index], std::move(generic));
+    if (ec) {
+      auto timer = std::make_shared<asio::steady_timer>(io_, kAcceptRetry);
+      timer->async_wait([this, index, timer, alive](const asio::error_code& wait_ec) {
+        if (!wait_ec && !alive.expired() && !closed_) AcceptUnix(index);
+      });
+      return;
+    }
+    AcceptUnix(index);
+  });
+}
+
+void BrokerServer::OnAccept(const asio::error_code& ec, std::string peer,
+                            asio::generic::stream_protocol::socket socket) {
+  if (ec) {
+    spdlog::error("accepting a connection failed: {}; retrying in {} ms", ec.message(), kAcceptRetry.count());
+    return;
+  }
+  stats_->accepted++;
+  const std::string label = "session " + std::to_string(next_session_++) + " (" + peer + ")";
+  auto session = std::make_shared<detail::Session>(broker_, options_, stats_, std::move(socket), label,
+                                                   [this](detail::Session* s) { Remove(s); });
+  sessions_.emplace(session.get(), session);
+  session->Start();
+}
+
+void BrokerServer::Remove(detail::Session* session) {
+  sessions_.erase(session);
+}
+
+void BrokerServer::Close() {
+  if (closed_) return;
+  closed_ = true;
+  asio::error_code ignored;
+  for (auto& a : tcp_)
+    a->close(ignored);
+  for (auto& a : unix_)
+    a->close(ignored);
+  for (const auto& path : unix_paths_)
+    ::unlink(path.c_str());
+  // Sessions remove themselves from the map while closing: close a copy.
+  auto sessions = std::move(sessions_);
+  sessions_.clear();
+  for (auto& [ptr, session] : sessions)
+    session->Close("broker shutting down", detail::Session::Farewell::kError, spdlog::level::debug);
+}
+
+}  // namespace canfleet::transport

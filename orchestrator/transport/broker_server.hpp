@@ -1,0 +1,95 @@
+#pragma once
+/// @file Serves a Broker's buses to node processes over the node <-> broker protocol
+/// (bus/wire/canfleet_wire.proto), on TCP and Unix-domain sockets.
+
+#include <asio/generic/stream_protocol.hpp>
+#include <asio/io_context.hpp>
+#include <asio/ip/tcp.hpp>
+#include <asio/local/stream_protocol.hpp>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "bus/wire/endpoint.hpp"
+#include "orchestrator/broker/broker.hpp"
+
+namespace canfleet::transport {
+
+namespace detail {
+class Session;
+}
+
+struct ServerOptions {
+  /// Bytes a session may have waiting for a slow reader; deliveries beyond it are dropped and
+  /// counted (a receiver that does not read loses frames, like a CAN controller's overrun).
+  std::size_t max_backlog_bytes = std::size_t{64} << 20;
+  /// A connection that has not sent its Hello by then is closed.
+  std::chrono::milliseconds hello_timeout{10'000};
+  /// After a protocol error, how long the Error message may take to leave before the socket is
+  /// closed anyway.
+  std::chrono::milliseconds close_linger{1'000};
+};
+
+struct ServerStats {
+  std::uint64_t accepted = 0;         ///< connections accepted
+  std::uint64_t attached = 0;         ///< Hellos accepted
+  std::uint64_t refused = 0;          ///< Hellos refused (version, unknown bus, bad names)
+  std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or out-of-order data
+  std::uint64_t backlog_drops = 0;    ///< frames not sent to slow readers
+};
+
+/// Accepts connections and runs one session per connection: a valid Hello attaches a port to the
+/// named bus (Broker::Attach), frames it sends are submitted, and what the broker delivers to the
+/// port (frames, controller events, TX confirmations) is written back in batches, one write in
+/// flight per connection. A malformed, oversized or out-of-order message closes that connection
+/// with a logged reason; the broker and the other sessions carry on.
+///
+/// Threading: everything runs on the thread running `io`, which must also drive the Broker's
+/// scheduler (AsioScheduler on the same io_context).
+class BrokerServer {
+ public:
+  BrokerServer(asio::io_context& io, broker::Broker& broker, ServerOptions options = {});
+  /// Closes every session (detaching their ports) and the listeners.
+  ~BrokerServer();
+  BrokerServer(const BrokerServer&) = delete;
+  BrokerServer& operator=(const BrokerServer&) = delete;
+
+  /// Starts accepting on `endpoint` and returns where it listens (the real port when `endpoint`
+  /// asks for port 0). A TCP address other than loopback must be asked for explicitly; it is
+  /// logged as reachable from other hosts. For a Unix socket, a stale socket file (nobody
+  /// listening) is replaced. Throws std::system_error when binding fails and
+  /// std::runtime_error when another process listens on the socket path.
+  wire::Endpoint Listen(const wire::Endpoint& endpoint);
+
+  /// Stops accepting and closes every session. Unix socket files created by Listen are removed.
+  void Close();
+
+  std::size_t SessionCount() const { return sessions_.size(); }
+  const std::vector<wire::Endpoint>& Endpoints() const { return endpoints_; }
+  const ServerStats& Stats() const { return *stats_; }
+
+ private:
+  void AcceptTcp(std::size_t index);
+  void AcceptUnix(std::size_t index);
+  void OnAccept(const asio::error_code& ec, std::string peer, asio::generic::stream_protocol::socket socket);
+  void Remove(detail::Session* session);
+
+  asio::io_context& io_;
+  broker::Broker& broker_;
+  ServerOptions options_;
+  std::shared_ptr<ServerStats> stats_ = std::make_shared<ServerStats>();  ///< shared with the sessions
+  /// Owned by the server alone: acceptor handlers that outlive it see it expired.
+  std::shared_ptr<int> alive_ = std::make_shared<int>(0);
+  std::vector<std::unique_ptr<asio::ip::tcp::acceptor>> tcp_;
+  std::vector<std::unique_ptr<asio::local::stream_protocol::acceptor>> unix_;
+  std::vector<std::string> unix_paths_;  ///< socket files to remove on Close
+  std::vector<wire::Endpoint> endpoints_;
+  std::unordered_map<detail::Session*, std::shared_ptr<detail::Session>> sessions_;
+  std::uint64_t next_session_ = 1;
+  bool closed_ = false;
+};
+
+}  // namespace canfleet::transport

@@ -1,0 +1,291 @@
+#include "orchestrator/transport/session.hpp"
+
+#include <asio/post.hpp>
+#include <asio/write.hpp>
+#include <stdexcept>
+
+namespace canfleet::transport::detail {
+
+namespace {
+
+constexpr std::size_t kReadChunk = 64 * 1024;
+
+asio::mutable_buffer Buffer(std::span<std::uint8_t> s) {
+  return {s.data(), s.size()};
+}
+asio::const_buffer Buffer(std::span<const std::uint8_t> s) {
+  return {s.data(), s.size()};
+}
+
+wire::StampedFrame Stamped(const broker::TimedFrame& f) {
+  return {f.frame, f.time};
+}
+
+std::string JoinBuses(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names)
+    out += (out.empty() ? "" : ", ") + n;
+  return out.empty() ? "none" : out;
+}
+
+}  // namespace
+
+Session::Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
+                 asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed)
+    : broker_(broker),
+      options_(options),
+      stats_(std::move(stats)),
+      socket_(std::move(socket)),
+      timer_(socket_.get_executor()),
+      label_(std::move(label)),
+      on_closed_(std::move(on_closed)) {}
+
+Session::~Session() {
+  // Close() detaches before the last reference goes; this only guards a session that never ran.
+  if (port_ != 0 && !closed_) broker_.Detach(port_);
+}
+
+void Session::Start() {
+  spdlog::debug("{}: connected", label_);
+  timer_.expires_after(options_.hello_timeout);
+  timer_.async_wait([this, self = shared_from_this()](const asio::error_code& ec) {
+    if (ec || closed_ || port_ != 0) return;
+    stats_->protocol_errors++;
+    Close("no Hello within " + std::to_string(options_.hello_timeout.count()) + " ms", Farewell::kError,
+          spdlog::level::warn);
+  });
+  Read();
+}
+
+void Session::Read() {
+  socket_.async_read_some(Buffer(decoder_.WritableSpace(kReadChunk)),
+                          [this, self = shared_from_this()](const asio::error_code& ec, std::size_t n) {
+                            if (closed_) return;
+                            if (ec) {
+                              Close(ec == asio::error::eof ? "peer disconnected" : ec.message(),
+                                    Farewell::kNone, spdlog::level::info);
+                              return;
+                            }
+                            decoder_.Commit(n);
+                            for (;;) {
+                              const auto result = decoder_.Next(message_);
+                              if (result == wire::StreamDecoder::Result::kNeedMore) break;
+                              if (result == wire::StreamDecoder::Result::kError) {
+                                ProtocolError(decoder_.Error());
+                                return;
+                              }
+                              Handle(message_);
+                              if (closed_) return;
+                            }
+                            Read();
+                          });
+}
+
+void Session::Handle(const wire::Message& m) {
+  using wire::MessageType;
+  if (port_ == 0 && m.type != MessageType::kHello && m.type != MessageType::kPing &&
+      m.type != MessageType::kError) {
+    ProtocolError(std::string(wire::ToString(m.type)) + " before Hello");
+    return;
+  }
+  switch (m.type) {
+    case MessageType::kHello:
+      if (port_ != 0) {
+        ProtocolError("second Hello");
+        return;
+      }
+      OnHello(m.envelope.hello());
+      return;
+    case MessageType::kFrames: {
+      submit_.resize(m.frames.size());
+      for (std::size_t i = 0; i < m.frames.size(); ++i)
+        submit_[i] = m.frames[i].frame;
+      broker_.Submit(port_, submit_);  // refusals (bus-off, full queue) are counted by the broker
+      return;
+    }
+    case MessageType::kPing:
+      filling_.AddPong(m.envelope.ping().nonce());
+      ScheduleFlush();
+      return;
+    case MessageType::kPong:
+      return;
+    case MessageType::kError:
+      Close("peer closed the connection: " + m.envelope.error().reason(), Farewell::kNone,
+            spdlog::level::info);
+      return;
+    case MessageType::kHelloReply:
+    case MessageType::kTxConfirm:
+    case MessageType::kControllerEvent:
+      ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from a node");
+      return;
+  }
+}
+
+void Session::OnHello(const wire::Hello& hello) {
+  if (hello.protocol_version() != wire::kProtocolVersion) {
+    Refuse("protocol version " + std::to_string(hello.protocol_version()) +
+           " not supported: this broker speaks version " + std::to_string(wire::kProtocolVersion));
+    return;
+  }
+  if (hello.bus().empty() || hello.bus().size() > wire::kMaxNameLength ||
+      hello.node_name().size() > wire::kMaxNameLength) {
+    Refuse("bus name must be 1.." + std::to_string(wire::kMaxNameLength) + " bytes, node name at most " +
+           std::to_string(wire::kMaxNameLength));
+    return;
+  }
+  if (hello.node_id() > 127) {
+    Refuse("node_id " + std::to_string(hello.node_id()) + " outside 0..127");
+    return;
+  }
+  broker::AttachOptions attach;
+  switch (hello.role()) {
+    case wire::ROLE_UNSPECIFIED:
+    case wire::ROLE_NODE:
+      break;
+    case wire::ROLE_MONITOR:
+      attach.listen_only = true;
+      attach.error_frames = true;
+      break;
+    default:
+      Refuse("unknown role " + std::to_string(hello.role()));
+      return;
+  }
+  std::string name = hello.node_name().empty() ? label_ : hello.node_name();
+  try {
+    port_ = broker_.Attach(hello.bus(), name, *this, attach);
+  } catch (const std::invalid_argument&) {
+    Refuse("unknown bus " + hello.bus() + " (this broker has: " + JoinBuses(broker_.Buses()) + ")");
+    return;
+  }
+  timer_.cancel();
+  tx_confirmations_ = hello.tx_confirmations();
+  const broker::BusStats bus = broker_.Stats(hello.bus(), 0);
+  label_ = "session " + label_.substr(label_.find(' ') + 1) + " [" + name + " on " + hello.bus() + ", port " +
+           std::to_string(port_) + "]";
+  wire::HelloReply reply;
+  reply.set_accepted(true);
+  reply.set_protocol_version(wire::kProtocolVersion);
+  reply.set_bitrate(bus.bitrate);
+  reply.set_mode(bus.paced ? wire::BUS_MODE_PACED : wire::BUS_MODE_UNPACED);
+  reply.set_port_id(port_);
+  filling_.AddHelloReply(reply);
+  ScheduleFlush();
+  stats_->attached++;
+  spdlog::info("{}: attached ({}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
+               hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string());
+}
+
+void Session::Refuse(const std::string& reason) {
+  stats_->refused++;
+  wire::HelloReply reply;
+  reply.set_accepted(false);
+  reply.set_reason(reason);
+  reply.set_protocol_version(wire::kProtocolVersion);
+  filling_.AddHelloReply(reply);
+  Close("refused: " + reason, Farewell::kDrain, spdlog::level::warn);
+}
+
+void Session::ProtocolError(const std::string& reason) {
+  stats_->protocol_errors++;
+  Close("protocol error: " + reason, Farewell::kError, spdlog::level::warn);
+}
+
+void Session::Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level) {
+  if (closed_) return;
+  const auto self = shared_from_this();  // on_closed_ drops the server's reference
+  closed_ = true;
+  spdlog::log(level, "{}: closed: {}", label_, reason);
+  if (port_ != 0) {
+    broker_.Detach(port_);  // no sink call reaches us after this
+    port_ = 0;
+  }
+  timer_.cancel();
+  if (on_closed_) on_closed_(this);
+  if (farewell == Farewell::kNone || !socket_.is_open()) {
+    CloseSocket();
+    return;
+  }
+  if (farewell == Farewell::kError) {
+    filling_.Clear();
+    filling_.AddError(reason);
+  }
+  Flush();
+  if (!write_in_flight_) {
+    CloseSocket();
+    return;
+  }
+  timer_.expires_after(options_.close_linger);
+  timer_.async_wait([this, self](const asio::error_code& ec) {
+    if (!ec) CloseSocket();
+  });
+}
+
+void Session::CloseSocket() {
+  asio::error_code ignored;
+  timer_.cancel();
+  socket_.shutdown(asio::socket_base::shutdown_both, ignored);
+  socket_.close(ignored);
+}
+
+void Session::Deliver(std::span<const broker::TimedFrame> frames) {
+  if (filling_.size() >= options_.max_backlog_bytes) {
+    if (backlog_drops_ == 0) spdlog::warn("{}: not reading; dropping frames for it", label_);
+    backlog_drops_ += frames.size();
+    stats_->backlog_drops += frames.size();
+    return;
+  }
+  filling_.AddFrames(wire::MessageType::kFrames, frames, Stamped);
+  ScheduleFlush();
+}
+
+void Session::ControllerChanged(const ControllerEvent& event) {
+  filling_.AddControllerEvent(event);
+  ScheduleFlush();
+}
+
+void Session::TxConfirmed(std::span<const broker::TimedFrame> frames) {
+  if (!tx_confirmations_) return;
+  filling_.AddFrames(wire::MessageType::kTxConfirm, frames, Stamped);
+  ScheduleFlush();
+}
+
+void Session::ScheduleFlush() {
+  if (flush_posted_ || write_in_flight_) return;
+  flush_posted_ = true;
+  asio::post(socket_.get_executor(), [this, self = shared_from_this()] {
+    flush_posted_ = false;
+    Flush();
+  });
+}
+
+void Session::Flush() {
+  if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
+  filling_.Swap(writing_);
+  write_in_flight_ = true;
+  asio::async_write(socket_, Buffer(writing_.Bytes()),
+                    [this, self = shared_from_this()](const asio::error_code& ec, std::size_t) {
+                      write_in_flight_ = false;
+                      writing_.Clear();
+                      if (ec) {
+                        if (closed_)
+                          CloseSocket();
+                        else
+                          Close(ec.message(), Farewell::kNone, spdlog::level::info);
+                        return;
+                      }
+                      if (!filling_.empty()) {
+                        Flush();
+                        return;
+                      }
+                      if (closed_) {
+                        CloseSocket();
+                        return;
+                      }
+                      if (backlog_drops_ != 0) {
+                        spdlog::warn("{}: reading again; {} frames were dropped", label_, backlog_drops_);
+                        backlog_drops_ = 0;
+                      }
+                    });
+}
+
+}  // namespace canfleet::transport::detail

@@ -1,0 +1,86 @@
+#pragma once
+/// @file One connection of a node to the broker: the protocol state machine and the broker port
+/// it attaches. Internal to BrokerServer.
+
+#include <spdlog/spdlog.h>
+
+#include <asio/generic/stream_protocol.hpp>
+#include <asio/steady_timer.hpp>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bus/wire/message_writer.hpp"
+#include "bus/wire/stream_decoder.hpp"
+#include "orchestrator/broker/broker.hpp"
+#include "orchestrator/transport/broker_server.hpp"
+
+namespace canfleet::transport::detail {
+
+/// A session follows asio's chat_server (style.md, "Asio lifetimes"): it is owned by shared_ptrs,
+/// every handler captures [this, self], and at most one write is in flight. Outgoing messages
+/// accumulate in one reused buffer while a write is in flight (the queue of batches, without an
+/// allocation per batch) and leave in the next write.
+///
+/// As a PortSink it only appends to that buffer and schedules a flush for the end of the current
+/// io_context turn, so everything one broker round produced for this port goes out in one write.
+class Session final : public std::enable_shared_from_this<Session>, public broker::PortSink {
+ public:
+  using ClosedHandler = std::function<void(Session*)>;
+
+  Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
+          asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed);
+  ~Session() override;
+
+  void Start();
+
+  /// What happens to the connection when the session ends.
+  enum class Farewell : std::uint8_t {
+    kNone,   ///< close now (the peer left, or the socket failed)
+    kDrain,  ///< write what is queued (a refusing HelloReply), then close
+    kError,  ///< drop what is queued, write Error{reason}, then close
+  };
+  /// Ends the session once: detaches the port, then closes the socket as `farewell` says (within
+  /// ServerOptions::close_linger at most). `level` is the log level of the reason.
+  void Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level);
+
+  // broker::PortSink
+  void Deliver(std::span<const broker::TimedFrame> frames) override;
+  void ControllerChanged(const ControllerEvent& event) override;
+  void TxConfirmed(std::span<const broker::TimedFrame> frames) override;
+
+ private:
+  void Read();
+  void Handle(const wire::Message& message);
+  void OnHello(const wire::Hello& hello);
+  void Refuse(const std::string& reason);
+  void ProtocolError(const std::string& reason);
+  void ScheduleFlush();
+  void Flush();
+  void CloseSocket();
+
+  broker::Broker& broker_;
+  const ServerOptions options_;
+  std::shared_ptr<ServerStats> stats_;
+  asio::generic::stream_protocol::socket socket_;
+  asio::steady_timer timer_;  ///< Hello deadline, then close linger
+  std::string label_;         ///< "session 3 (quad-5 on can0, port 7, tcp 127.0.0.1:40312)"
+  ClosedHandler on_closed_;
+
+  broker::PortId port_ = 0;  ///< 0 until a Hello is accepted
+  bool tx_confirmations_ = false;
+  bool closed_ = false;
+
+  wire::StreamDecoder decoder_;
+  wire::Message message_;
+  std::vector<CanFrame> submit_;  ///< frames of one received batch, reused
+
+  wire::MessageWriter filling_;
+  wire::MessageWriter writing_;
+  bool write_in_flight_ = false;
+  bool flush_posted_ = false;
+  std::uint64_t backlog_drops_ = 0;  ///< frames dropped in the current backlog episode
+};
+
+}  // namespace canfleet::transport::detail

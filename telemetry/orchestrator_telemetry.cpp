@@ -1,0 +1,227 @@
+#include "telemetry/orchestrator_telemetry.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <deque>
+#include <map>
+#include <stdexcept>
+
+#include "telemetry/samples.hpp"
+#include "telemetry/topics.hpp"
+
+namespace canfleet::telemetry {
+
+bool BusStatsChanged(const BusStatsSnapshot& a, const BusStatsSnapshot& b) {
+  return a.bitrate != b.bitrate || a.mode != b.mode || a.node_count != b.node_count ||
+         a.error_frames != b.error_frames;
+}
+
+namespace {
+
+void CheckBusName(const std::string& bus) {
+  if (bus.empty() || bus.size() > kMaxBusName) {
+    throw std::invalid_argument("bus name '" + bus + "' must have 1.." + std::to_string(kMaxBusName) +
+                                " characters");
+  }
+}
+
+/// Publisher-thread state of one bus.
+struct BusState {
+  BusStatsSnapshot current;
+  BusStatsSnapshot published;
+  bool change = true;
+  bool removed = false;
+  PublisherLoop::Clock::time_point written{};
+  PublisherLoop::Clock::time_point due{};
+  std::uint32_t serial = 0;
+};
+
+}  // namespace
+
+struct OrchestratorTelemetry::Impl {
+  explicit Impl(const Participant& participant, OrchestratorTelemetryOptions opts)
+      : options(opts),
+        stats_topic(participant),
+        fault_topic(participant),
+        stats_writer(participant, stats_topic),
+        fault_writer(participant, fault_topic) {
+    stats_sample.top_cob_ids = {static_cast<std::uint32_t>(cob_ids.size()), 0, cob_ids.data(), false};
+    fault_sample.parameters = {static_cast<std::uint32_t>(parameters.size()), 0, parameters.data(), false};
+  }
+
+  const OrchestratorTelemetryOptions options;
+  Topic<canfleet_telemetry_BusStats> stats_topic;
+  Topic<canfleet_telemetry_FaultEvent> fault_topic;
+  Writer<canfleet_telemetry_BusStats> stats_writer;
+  Writer<canfleet_telemetry_FaultEvent> fault_writer;
+
+  // Guarded by PublisherLoop::mutex().
+  std::map<std::string, BusStatsSnapshot, std::less<>> pending;
+  std::vector<std::string> pending_removals;
+  std::deque<FaultSnapshot> faults;
+
+  // Publisher thread.
+  std::map<std::string, BusState, std::less<>> buses;
+  std::vector<FaultSnapshot> fault_batch;
+  std::map<std::string, std::uint32_t, std::less<>> fault_serials;
+  canfleet_telemetry_BusStats stats_sample{};
+  std::array<canfleet_telemetry_CobIdRate, kMaxTopCobIds> cob_ids{};
+  canfleet_telemetry_FaultEvent fault_sample{};
+  std::array<canfleet_telemetry_FaultParameter, kMaxFaultParameters> parameters{};
+
+  std::atomic<std::uint64_t> state_writes{0};
+  std::atomic<std::uint64_t> event_writes{0};
+  std::atomic<std::uint64_t> write_errors{0};
+  std::atomic<std::uint64_t> events_dropped{0};
+
+  void Count(dds_return_t rc, std::atomic<std::uint64_t>& ok) {
+    (rc == DDS_RETCODE_OK ? ok : write_errors).fetch_add(1, std::memory_order_relaxed);
+  }
+
+  void WriteStats(BusState& bus) {
+    const BusStatsSnapshot& s = bus.current;
+    CopyBounded(stats_sample.bus, s.bus);
+    stats_sample.bitrate = s.bitrate;
+    CopyBounded(stats_sample.mode, s.mode);
+    stats_sample.load_percent = s.load_percent;
+    stats_sample.frames_per_second = s.frames_per_second;
+    stats_sample.frames_total = s.frames_total;
+    stats_sample.error_frames = s.error_frames;
+    stats_sample.node_count = s.node_count;
+    const std::size_t n = std::min<std::size_t>(s.top_cob_id_count, kMaxTopCobIds);
+    for (std::size_t i = 0; i < n; ++i)
+      cob_ids[i] = {s.top_cob_ids[i].cob_id, s.top_cob_ids[i].frames_per_second};
+    stats_sample.top_cob_ids._length = static_cast<std::uint32_t>(n);
+    stats_sample.serial = ++bus.serial;
+    Count(stats_writer.Write(stats_sample), state_writes);
+  }
+
+  void WriteFault(const FaultSnapshot& f) {
+    CopyBounded(fault_sample.bus, f.bus);
+    fault_sample.fault_id = f.fault_id;
+    fault_sample.action = ToDds(f.action);
+    CopyBounded(fault_sample.kind, f.kind);
+    fault_sample.target_node = f.target_node;
+    const std::size_t n = std::min(f.parameters.size(), kMaxFaultParameters);
+    for (std::size_t i = 0; i < n; ++i) {
+      CopyBounded(parameters[i].name, f.parameters[i].first);
+      CopyBounded(parameters[i].value, f.parameters[i].second);
+    }
+    fault_sample.parameters._length = static_cast<std::uint32_t>(n);
+    fault_sample.bus_time_ns = static_cast<std::uint64_t>(f.bus_time.count());
+    fault_sample.serial = ++fault_serials[f.bus];
+    Count(fault_writer.Write(fault_sample), event_writes);
+  }
+};
+
+OrchestratorTelemetry::OrchestratorTelemetry(const Participant& participant,
+                                             OrchestratorTelemetryOptions options)
+    : PublisherLoop(options.min_interval) {
+  if (options.period <= std::chrono::milliseconds::zero()) throw std::invalid_argument("period must be > 0");
+  impl_ = std::make_unique<Impl>(participant, options);
+  Start();
+}
+
+OrchestratorTelemetry::~OrchestratorTelemetry() {
+  Stop();
+}
+
+void OrchestratorTelemetry::UpdateBusStats(const BusStatsSnapshot& stats) {
+  CheckBusName(stats.bus);
+  bool notify;
+  {
+    const std::lock_guard lock(mutex());
+    auto it = impl_->pending.find(stats.bus);
+    if (it == impl_->pending.end()) {
+      impl_->pending.emplace(stats.bus, stats);
+    } else {
+      it->second = stats;
+    }
+    notify = MarkInputLocked();
+  }
+  if (notify) Notify();
+}
+
+void OrchestratorTelemetry::RemoveBus(const std::string& bus) {
+  bool notify;
+  {
+    const std::lock_guard lock(mutex());
+    impl_->pending.erase(bus);
+    impl_->pending_removals.push_back(bus);
+    notify = MarkEventLocked();
+  }
+  if (notify) Notify();
+}
+
+void OrchestratorTelemetry::PublishFault(FaultSnapshot fault) {
+  CheckBusName(fault.bus);
+  bool notify = false;
+  {
+    const std::lock_guard lock(mutex());
+    if (impl_->faults.size() >= impl_->options.fault_queue) {
+      impl_->events_dropped.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      impl_->faults.push_back(std::move(fault));
+      notify = MarkEventLocked();
+    }
+  }
+  if (notify) Notify();
+}
+
+PublisherStats OrchestratorTelemetry::stats() const {
+  return {impl_->state_writes.load(), impl_->event_writes.load(), impl_->write_errors.load(),
+          impl_->events_dropped.load()};
+}
+
+void OrchestratorTelemetry::ConsumeLocked(bool inputs) {
+  Impl& m = *impl_;
+  while (!m.faults.empty()) {
+    m.fault_batch.push_back(std::move(m.faults.front()));
+    m.faults.pop_front();
+  }
+  for (const std::string& bus : m.pending_removals) {
+    auto it = m.buses.find(bus);
+    if (it != m.buses.end()) it->second.removed = true;
+  }
+  m.pending_removals.clear();
+  if (!inputs) return;
+  for (auto& [name, snapshot] : m.pending) {
+    BusState& bus = m.buses[name];
+    bus.current = snapshot;
+    bus.removed = false;
+  }
+  m.pending.clear();
+}
+
+PublisherLoop::Clock::time_point OrchestratorTelemetry::Publish(Clock::time_point now, bool force) {
+  Impl& m = *impl_;
+  for (const FaultSnapshot& f : m.fault_batch)
+    m.WriteFault(f);
+  m.fault_batch.clear();
+
+  Clock::time_point next = now + m.options.period;
+  for (auto it = m.buses.begin(); it != m.buses.end();) {
+    BusState& bus = it->second;
+    if (bus.removed) {
+      canfleet_telemetry_BusStats key{};
+      CopyBounded(key.bus, it->first);
+      m.stats_writer.Dispose(key);
+      it = m.buses.erase(it);
+      continue;
+    }
+    bus.change = bus.change || BusStatsChanged(bus.current, bus.published);
+    if (now >= bus.due || (bus.change && (force || now >= bus.written + min_interval()))) {
+      m.WriteStats(bus);
+      bus.published = bus.current;
+      bus.change = false;
+      bus.written = now;
+      bus.due = now + m.options.period;
+    }
+    next = std::min(next, bus.due);
+    if (bus.change) next = std::min(next, bus.written + min_interval());
+    ++it;
+  }
+  return next;
+}
+
+}  // namespace canfleet::telemetry

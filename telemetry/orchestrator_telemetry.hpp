@@ -1,0 +1,92 @@
+#pragma once
+/// @file What the orchestrator publishes: BusStats per bus (on change and every period) and
+/// FaultEvent events. Same threading as NodeTelemetry (publisher_loop.hpp): callers copy, one
+/// thread writes.
+///
+/// @code
+///   telemetry::OrchestratorTelemetry telemetry(participant);
+///   telemetry::BusStatsSnapshot stats{.bus = "can0", .bitrate = 500000, .mode = "realtime", ...};
+///   telemetry.UpdateBusStats(stats);          // e.g. from the broker's 1 s statistics timer
+///   telemetry.PublishFault({.bus = "can0", .fault_id = 3, .action = FaultAction::kInjected,
+///                           .kind = "drop", .target_node = 5, .parameters = {{"cob_id", "0x705"}}});
+/// @endcode
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "telemetry/dds.hpp"
+#include "telemetry/node_telemetry.hpp"
+#include "telemetry/publisher_loop.hpp"
+#include "telemetry/types.hpp"
+
+namespace canfleet::telemetry {
+
+/// One bus's statistics. Bus and mode names fit std::string's small-string buffer (<= 15
+/// characters), so a copy does not allocate.
+struct BusStatsSnapshot {
+  std::string bus{};
+  std::uint32_t bitrate = 0;
+  std::string mode{};
+  float load_percent = 0;
+  float frames_per_second = 0;
+  std::uint64_t frames_total = 0;
+  std::uint64_t error_frames = 0;
+  std::uint16_t node_count = 0;
+  std::uint8_t top_cob_id_count = 0;
+  std::array<CobIdRate, kMaxTopCobIds> top_cob_ids{};
+};
+
+/// True if the configuration or the error picture changed (bitrate, mode, node count, error
+/// frames): those go out at once; rates and loads only every period.
+bool BusStatsChanged(const BusStatsSnapshot& a, const BusStatsSnapshot& b);
+
+/// A fault injected into or cleared from a bus. Faults are rare: this one may allocate.
+struct FaultSnapshot {
+  std::string bus{};
+  std::uint32_t fault_id = 0;
+  FaultAction action = FaultAction::kInjected;
+  std::string kind{};
+  std::uint8_t target_node = 0;                                   ///< 0 = the whole bus
+  std::vector<std::pair<std::string, std::string>> parameters{};  ///< at most kMaxFaultParameters
+  BusTime bus_time{};
+};
+
+struct OrchestratorTelemetryOptions {
+  std::chrono::milliseconds period{1000};
+  std::chrono::milliseconds min_interval{20};
+  std::size_t fault_queue = 256;
+};
+
+class OrchestratorTelemetry : private PublisherLoop {
+ public:
+  /// Creates topics and writers (throws DdsError) and starts the publisher thread.
+  explicit OrchestratorTelemetry(const Participant& participant, OrchestratorTelemetryOptions options = {});
+  ~OrchestratorTelemetry();
+  OrchestratorTelemetry(const OrchestratorTelemetry&) = delete;
+  OrchestratorTelemetry& operator=(const OrchestratorTelemetry&) = delete;
+
+  /// Hands over one bus's statistics (keyed by stats.bus). Any thread; never blocks on DDS.
+  /// Throws std::invalid_argument for a bus name longer than kMaxBusName.
+  void UpdateBusStats(const BusStatsSnapshot& stats);
+  /// Disposes a bus's BusStats instance (the bus was removed).
+  void RemoveBus(const std::string& bus);
+  /// Queues a fault event for immediate publication.
+  void PublishFault(FaultSnapshot fault);
+
+  using PublisherLoop::Flush;
+  PublisherStats stats() const;
+
+ private:
+  struct Impl;
+  void ConsumeLocked(bool inputs) override;
+  Clock::time_point Publish(Clock::time_point now, bool force) override;
+
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace canfleet::telemetry

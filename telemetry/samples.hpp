@@ -1,0 +1,126 @@
+#pragma once
+/// @file Reader-side C++ values of the five topics, converted from the idlc-generated C samples.
+/// Tools and tests work on these; only telemetry/ touches the C types.
+
+#include <chrono>
+#include <compare>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "canfleet_telemetry.h"
+#include "telemetry/types.hpp"
+
+namespace canfleet::telemetry {
+
+/// The key of NodeStatus and IoSnapshot.
+struct NodeKey {
+  std::string bus{};
+  std::uint8_t node_id = 0;
+  friend auto operator<=>(const NodeKey&, const NodeKey&) = default;
+};
+
+struct NodeStatusSample {
+  std::string bus{};
+  std::uint8_t node_id = 0;
+  std::string device{};
+  std::optional<NmtState> nmt_state{};  ///< nullopt: unknown
+  std::uint8_t error_register = 0;
+  ControllerState controller_state = ControllerState::kErrorActive;
+  std::uint16_t tec = 0;
+  std::uint8_t rec = 0;
+  std::uint16_t heartbeat_producer_ms = 0;
+  std::vector<HeartbeatConsumerInfo> heartbeat_consumers{};
+  std::uint64_t rpdo_count = 0;
+  std::uint64_t tpdo_count = 0;
+  std::chrono::milliseconds uptime{};
+  std::optional<EmcyInfo> last_emcy{};
+  std::chrono::milliseconds publish_period{};
+  std::uint32_t serial = 0;
+
+  NodeKey key() const { return {bus, node_id}; }
+};
+
+struct EmcySample {
+  std::string bus{};
+  std::uint8_t node_id = 0;
+  EmcyInfo emcy{};
+  std::uint32_t serial = 0;
+};
+
+struct IoValueSample {
+  std::string name{};
+  double value = 0;
+  std::string unit{};
+  friend bool operator==(const IoValueSample&, const IoValueSample&) = default;
+};
+
+struct IoSnapshotSample {
+  std::string bus{};
+  std::uint8_t node_id = 0;
+  std::vector<IoValueSample> inputs{};
+  std::vector<IoValueSample> outputs{};
+  std::uint32_t serial = 0;
+};
+
+struct BusStatsSample {
+  std::string bus{};
+  std::uint32_t bitrate = 0;
+  std::string mode{};
+  float load_percent = 0;
+  float frames_per_second = 0;
+  std::uint64_t frames_total = 0;
+  std::uint64_t error_frames = 0;
+  std::uint16_t node_count = 0;
+  std::vector<CobIdRate> top_cob_ids{};
+  std::uint32_t serial = 0;
+};
+
+struct FaultEventSample {
+  std::string bus{};
+  std::uint32_t fault_id = 0;
+  FaultAction action = FaultAction::kInjected;
+  std::string kind{};
+  std::uint8_t target_node = 0;  ///< 0 = the whole bus
+  std::vector<std::pair<std::string, std::string>> parameters{};
+  BusTime bus_time{};
+  std::uint32_t serial = 0;
+};
+
+NodeStatusSample FromDds(const canfleet_telemetry_NodeStatus& sample);
+EmcySample FromDds(const canfleet_telemetry_Emcy& sample);
+IoSnapshotSample FromDds(const canfleet_telemetry_IoSnapshot& sample);
+BusStatsSample FromDds(const canfleet_telemetry_BusStats& sample);
+FaultEventSample FromDds(const canfleet_telemetry_FaultEvent& sample);
+
+// Enum mappings between our types and the IDL's.
+canfleet_telemetry_NmtState ToDds(std::optional<NmtState> state);
+std::optional<NmtState> FromDds(canfleet_telemetry_NmtState state);
+canfleet_telemetry_ControllerState ToDds(ControllerState state);
+ControllerState FromDds(canfleet_telemetry_ControllerState state);
+canfleet_telemetry_HeartbeatConsumerState ToDds(HeartbeatConsumerState state);
+HeartbeatConsumerState FromDds(canfleet_telemetry_HeartbeatConsumerState state);
+canfleet_telemetry_FaultAction ToDds(FaultAction action);
+FaultAction FromDds(canfleet_telemetry_FaultAction action);
+
+/// Copies `text` into a bounded IDL string (char[N]), truncating to N-1 characters.
+template <std::size_t N>
+void CopyBounded(char (&out)[N], std::string_view text) {
+  const std::size_t n = text.size() < N - 1 ? text.size() : N - 1;
+  text.copy(out, n);
+  out[n] = '\0';
+}
+
+/// Reads a bounded IDL string; never reads past the array even if it is not terminated.
+template <std::size_t N>
+std::string FromBounded(const char (&text)[N]) {
+  std::size_t n = 0;
+  while (n < N && text[n] != '\0')
+    ++n;
+  return std::string(text, n);
+}
+
+}  // namespace canfleet::telemetry

@@ -1,0 +1,261 @@
+#include "tests/system/support/child_process.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "bus/wire/endpoint.hpp"
+
+extern char** environ;
+
+namespace canfleet::system_test {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int RemainingMs(Clock::time_point deadline) {
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+  return left < 0 ? 0 : static_cast<int>(left);
+}
+
+[[noreturn]] void Fail(const std::string& what) {
+  throw std::runtime_error(what + ": " + std::strerror(errno));
+}
+
+}  // namespace
+
+bool WaitUntil(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  for (;;) {
+    if (condition()) return true;
+    if (Clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+std::uint16_t FreeTcpPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) Fail("socket");
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  addr.sin_port = 0;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) Fail("bind");
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  ::close(fd);
+  return ntohs(addr.sin_port);
+}
+
+TempDir::TempDir() {
+  char tmpl[] = "/tmp/cfst.XXXXXX";
+  if (::mkdtemp(tmpl) == nullptr) Fail("mkdtemp");
+  path_ = tmpl;
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  std::filesystem::remove_all(path_, ignored);
+}
+
+ChildProcess::ChildProcess(std::vector<std::string> argv, std::string stderr_path)
+    : stderr_path_(std::move(stderr_path)) {
+  int in[2];
+  int out[2];
+  if (::pipe2(in, O_CLOEXEC) != 0 || ::pipe2(out, O_CLOEXEC) != 0) Fail("pipe2");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, in[0], STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_path_.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  std::vector<char*> args;
+  for (auto& a : argv)
+    args.push_back(a.data());
+  args.push_back(nullptr);
+  const int rc = ::posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(in[0]);
+  ::close(out[1]);
+  stdin_fd_ = in[1];
+  stdout_fd_ = out[0];
+  if (rc != 0) {
+    errno = rc;
+    Fail("posix_spawn " + argv[0]);
+  }
+  ::fcntl(stdout_fd_, F_SETFL, ::fcntl(stdout_fd_, F_GETFL) | O_NONBLOCK);
+  // A child that exits must not kill us with SIGPIPE when we write to its stdin.
+  ::signal(SIGPIPE, SIG_IGN);
+}
+
+ChildProcess::~ChildProcess() {
+  if (Running()) {
+    ::kill(pid_, SIGKILL);
+    Wait(std::chrono::seconds(30));
+  }
+  if (stdin_fd_ >= 0) ::close(stdin_fd_);
+  if (stdout_fd_ >= 0) ::close(stdout_fd_);
+}
+
+void ChildProcess::WriteLine(const std::string& line) {
+  const std::string data = line + "\n";
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(stdin_fd_, data.data() + done, data.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return;  // the child is gone; the test sees it in its output
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+bool ChildProcess::ReadSome(int timeout_ms) {
+  pollfd p{stdout_fd_, POLLIN, 0};
+  if (::poll(&p, 1, timeout_ms) <= 0) return true;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(stdout_fd_, buf, sizeof buf);
+    if (n == 0) return false;  // closed
+    if (n < 0) return errno == EAGAIN || errno == EINTR;
+    partial_.append(buf, static_cast<std::size_t>(n));
+    std::size_t start = 0;
+    for (std::size_t nl; (nl = partial_.find('\n', start)) != std::string::npos; start = nl + 1)
+      lines_.push_back(partial_.substr(start, nl - start));
+    partial_.erase(0, start);
+  }
+}
+
+void ChildProcess::Poll() {
+  ReadSome(0);
+}
+
+std::optional<std::string> ChildProcess::WaitForLine(const std::function<bool(const std::string&)>& match,
+                                                     std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  for (;;) {
+    for (; scanned_ < lines_.size(); ++scanned_)
+      if (match(lines_[scanned_])) return lines_[scanned_++];
+    if (Clock::now() >= deadline) return std::nullopt;
+    if (!ReadSome(std::min(RemainingMs(deadline), 50)) && scanned_ == lines_.size()) return std::nullopt;
+  }
+}
+
+std::optional<std::string> ChildProcess::WaitForPrefix(const std::string& prefix,
+                                                       std::chrono::milliseconds timeout) {
+  return WaitForLine([&](const std::string& line) { return line.starts_with(prefix); }, timeout);
+}
+
+void ChildProcess::Signal(int signal) {
+  if (Running()) ::kill(pid_, signal);
+}
+
+bool ChildProcess::Running() {
+  if (status_) return false;
+  int status = 0;
+  const pid_t r = ::waitpid(pid_, &status, WNOHANG);
+  if (r == pid_) {
+    status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return false;
+  }
+  return r == 0;
+}
+
+std::optional<int> ChildProcess::Wait(std::chrono::milliseconds timeout) {
+  WaitUntil([&] { return !Running(); }, timeout);
+  return status_;
+}
+
+std::string ChildProcess::Log() const {
+  std::ifstream in(stderr_path_);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+RawConnection::RawConnection(const std::string& endpoint) {
+  const wire::Endpoint ep = wire::Endpoint::Parse(endpoint);
+  if (ep.kind == wire::Endpoint::Kind::kUnix) {
+    fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::strncpy(addr.sun_path, ep.path.c_str(), sizeof(addr.sun_path) - 1);
+    if (::connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      ::close(fd_);
+      fd_ = -1;
+    }
+    return;
+  }
+  fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(ep.port);
+  ::inet_pton(AF_INET, ep.host == "localhost" ? "127.0.0.1" : ep.host.c_str(), &addr.sin_addr);
+  if (::connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd_);
+    fd_ = -1;
+  }
+}
+
+RawConnection::~RawConnection() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool RawConnection::Send(const std::string& bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+bool RawConnection::Send(const std::vector<std::uint8_t>& bytes) {
+  return Send(std::string(bytes.begin(), bytes.end()));
+}
+
+RawConnection::ReadResult RawConnection::ReadAtLeast(std::size_t want, std::chrono::milliseconds timeout) {
+  ReadResult result;
+  const auto deadline = Clock::now() + timeout;
+  while (result.bytes.size() < want) {
+    pollfd p{fd_, POLLIN, 0};
+    const int ready = ::poll(&p, 1, RemainingMs(deadline));
+    if (ready <= 0) return result;
+    std::uint8_t buf[65536];
+    const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+    if (n <= 0) {
+      if (n < 0 && errno == EINTR) continue;
+      result.closed = true;  // orderly close, or reset by the peer
+      return result;
+    }
+    result.bytes.insert(result.bytes.end(), buf, buf + n);
+  }
+  return result;
+}
+
+RawConnection::ReadResult RawConnection::ReadUntilClosed(std::chrono::milliseconds timeout) {
+  return ReadAtLeast(SIZE_MAX, timeout);
+}
+
+}  // namespace canfleet::system_test

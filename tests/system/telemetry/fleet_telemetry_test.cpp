@@ -1,0 +1,223 @@
+// Issue 7, "Tests": a fleet of >= 20 node processes publishes over DDS; a reader sees every node's
+// status within a bound, sees the EMCY and the FaultEvent when a fault is injected and sees the
+// recovery; a late-joining reader (canfleet-top, canfleet-watch) still gets the status of all nodes
+// and the fault history (transient-local).
+//
+// Publishers are canfleet-fake-fleet processes (tools/telemetry/fake_fleet_main.cpp) until the real
+// node and orchestrator processes publish through the same library. Commands on their stdin
+// ("fault 7 passive", "recover 7") are answered "ok ..." once handed to the publishers.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+#include "telemetry/fleet_reader.hpp"
+#include "tests/system/support/child_process.hpp"
+#include "tools/telemetry/fleet_view.hpp"
+
+namespace canfleet::system_test {
+namespace {
+
+using namespace std::chrono_literals;
+using telemetry::ControllerState;
+using tools::EventKind;
+using tools::FleetEvent;
+using tools::FleetView;
+
+/// Discovery of 20+ processes over unicast loopback plus their start-up on a loaded CI machine.
+constexpr auto kFleetPatience = 60s;
+
+std::vector<std::string> DdsArgs(std::uint32_t domain) {
+  return {"--dds-domain", std::to_string(domain), "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG};
+}
+
+/// A test-side monitor: a participant, a FleetReader and the model tools use.
+class Monitor {
+ public:
+  explicit Monitor(std::uint32_t domain)
+      : participant_({.domain_id = domain, .config_file = CANFLEET_DDS_LOOPBACK_CONFIG}),
+        view_(std::chrono::system_clock::now()),
+        reader_(participant_,
+                {.node_status = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
+                 .emcy = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
+                 .io = {},
+                 .bus_stats = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
+                 .fault = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); }}) {}
+
+  bool Until(const std::function<bool()>& condition, std::chrono::milliseconds timeout = kPatience) {
+    return WaitUntil(
+        [&] {
+          reader_.Poll();
+          return condition();
+        },
+        timeout);
+  }
+  const FleetView& view() const { return view_; }
+  const std::vector<FleetEvent>& events() const { return events_; }
+  bool Has(const std::function<bool(const FleetEvent&)>& match) const {
+    return std::any_of(events_.begin(), events_.end(), match);
+  }
+  const tools::NodeRow* Node(const std::string& bus, std::uint8_t id) const {
+    const auto it = view_.nodes().find({bus, id});
+    return it == view_.nodes().end() ? nullptr : &it->second;
+  }
+
+ private:
+  telemetry::Participant participant_;
+  FleetView view_;
+  std::vector<FleetEvent> events_;
+  telemetry::FleetReader reader_;
+};
+
+class FleetTelemetry : public ::testing::Test {
+ protected:
+  static constexpr std::uint32_t kDomain = 90;
+  static constexpr int kNodes = 20;
+
+  std::unique_ptr<ChildProcess> Spawn(std::vector<std::string> args, const std::string& name) {
+    std::vector<std::string> argv = {PROGRAM_CANFLEET_FAKE_FLEET};
+    for (auto& a : DdsArgs(kDomain))
+      argv.push_back(a);
+    for (auto& a : args)
+      argv.push_back(a);
+    auto child = std::make_unique<ChildProcess>(argv, dir_.File(name + ".log"));
+    return child;
+  }
+
+  void StartFleet() {
+    orchestrator_ = Spawn({"--bus", "sys0", "--nodes", "0", "--orchestrator", "--commands"}, "orchestrator");
+    for (int id = 1; id <= kNodes; ++id) {
+      nodes_[id] = Spawn({"--bus", "sys0", "--nodes", "1", "--first-node", std::to_string(id), "--commands",
+                          "--device", id % 2 ? "quad-controller" : "valve-12in12out"},
+                         "node" + std::to_string(id));
+    }
+    ASSERT_TRUE(orchestrator_->WaitForPrefix("ready", kFleetPatience)) << orchestrator_->Log();
+    for (auto& [id, node] : nodes_)
+      ASSERT_TRUE(node->WaitForPrefix("ready", kFleetPatience)) << node->Log();
+  }
+
+  /// Sends a command to a process and waits for its acknowledgement.
+  static void Command(ChildProcess& process, const std::string& line) {
+    process.WriteLine(line);
+    ASSERT_TRUE(process.WaitForPrefix("ok " + line)) << process.Log();
+  }
+
+  std::string RunTool(const std::string& program, std::vector<std::string> args, const std::string& name) {
+    std::vector<std::string> argv = {program};
+    for (auto& a : DdsArgs(kDomain))
+      argv.push_back(a);
+    for (auto& a : args)
+      argv.push_back(a);
+    ChildProcess tool(argv, dir_.File(name + ".log"));
+    const auto status = tool.Wait(kFleetPatience);
+    EXPECT_EQ(status, std::optional<int>(0)) << tool.Log();
+    tool.Poll();
+    std::string out;
+    for (const auto& line : tool.Lines())
+      out += line + "\n";
+    return out;
+  }
+
+  TempDir dir_;
+  std::unique_ptr<ChildProcess> orchestrator_;
+  std::map<int, std::unique_ptr<ChildProcess>> nodes_;
+};
+
+TEST_F(FleetTelemetry, ReaderSeesEveryNodeTheFaultAndTheRecoveryAndLateJoinersSeeTheFleet) {
+  Monitor monitor(kDomain);
+  StartFleet();
+  // Given 20 node processes: every node's status reaches the reader.
+  ASSERT_TRUE(monitor.Until([&] { return monitor.view().nodes().size() == kNodes; }, kFleetPatience))
+      << monitor.view().nodes().size() << " nodes seen";
+  for (int id = 1; id <= kNodes; ++id) {
+    const auto* node = monitor.Node("sys0", static_cast<std::uint8_t>(id));
+    ASSERT_NE(node, nullptr) << id;
+    EXPECT_EQ(node->status.controller_state, ControllerState::kErrorActive);
+    EXPECT_EQ(node->status.device, id % 2 ? "quad-controller" : "valve-12in12out");
+  }
+
+  // When the orchestrator injects a fault on node 7 and node 7's controller reacts:
+  Command(*orchestrator_, "fault 7 passive");
+  Command(*nodes_[7], "fault 7 passive");
+  // Then the reader sees the FaultEvent, the EMCY (8120h: CAN in error passive, CiA 301 table 21)
+  // and node 7's status change, and no other node changes.
+  ASSERT_TRUE(monitor.Until([&] {
+    return monitor.Has([](const FleetEvent& e) {
+      return e.kind == EventKind::kFault && e.fault->action == telemetry::FaultAction::kInjected &&
+             e.fault->target_node == 7;
+    }) && monitor.Has([](const FleetEvent& e) {
+      return e.kind == EventKind::kEmcy && e.node_id == 7 && e.emcy->emcy.code == 0x8120;
+    }) && monitor.Node("sys0", 7)->status.controller_state == ControllerState::kErrorPassive;
+  }));
+  EXPECT_EQ(monitor.Node("sys0", 7)->status.error_register, 0x11);
+  EXPECT_EQ(monitor.Node("sys0", 8)->status.controller_state, ControllerState::kErrorActive);
+  EXPECT_EQ(monitor.view().buses().at("sys0").active_faults.size(), 1u);
+
+  // When the fault is cleared: the recovery (FaultEvent cleared, EMCY 0000h error reset, status active).
+  Command(*orchestrator_, "recover 7");
+  Command(*nodes_[7], "recover 7");
+  ASSERT_TRUE(monitor.Until([&] {
+    return monitor.Has([](const FleetEvent& e) {
+      return e.kind == EventKind::kFault && e.fault->action == telemetry::FaultAction::kCleared;
+    }) && monitor.Has([](const FleetEvent& e) {
+      return e.kind == EventKind::kEmcy && e.node_id == 7 && e.emcy->emcy.code == 0x0000;
+    }) && monitor.Node("sys0", 7)->status.controller_state == ControllerState::kErrorActive &&
+           monitor.Node("sys0", 7)->status.error_register == 0;
+  }));
+  EXPECT_TRUE(monitor.view().buses().at("sys0").active_faults.empty());
+
+  // A late joiner: canfleet-top, started now, prints every node's current status at once.
+  const std::string top =
+      RunTool(PROGRAM_CANFLEET_TOP, {"--once", "--height", "60", "--color", "never", "--wait", "30"}, "top");
+  int rows = 0;
+  std::istringstream lines(top);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("sys0 ", 0) == 0 && line.find("kbit/s") == std::string::npos) ++rows;
+  }
+  EXPECT_EQ(rows, kNodes) << top;
+  EXPECT_NE(top.find("20 nodes on 1 buses, 0 faulted"), std::string::npos) << top;
+
+  // A late canfleet-watch gets the fault history (transient-local events) as JSON lines.
+  const std::string watch = RunTool(
+      PROGRAM_CANFLEET_WATCH, {"--json", "--type", "fault", "--count", "2", "--timeout", "30"}, "watch");
+  EXPECT_NE(watch.find(R"("type":"fault","bus":"sys0","node":7,"fault_id":1,"action":"injected")"),
+            std::string::npos)
+      << watch;
+  EXPECT_NE(watch.find(R"("action":"cleared")"), std::string::npos) << watch;
+  EXPECT_NE(watch.find(R"("replay":true)"), std::string::npos) << watch;
+
+  // A node that exits cleanly disposes its status: the reader sees it leave.
+  nodes_[20]->WriteLine("quit");
+  ASSERT_TRUE(monitor.Until([&] { return !monitor.Node("sys0", 20)->alive; }));
+  EXPECT_TRUE(monitor.Node("sys0", 20)->disposed);
+}
+
+TEST(FleetTelemetryScale, TopShows127NodesOfOneBus) {
+  TempDir dir;
+  std::vector<std::string> argv = {PROGRAM_CANFLEET_FAKE_FLEET};
+  for (auto& a : DdsArgs(91))
+    argv.push_back(a);
+  for (std::string a : {"--bus", "big0", "--nodes", "127", "--orchestrator", "--commands"})
+    argv.push_back(a);
+  ChildProcess fleet(argv, dir.File("fleet.log"));
+  ASSERT_TRUE(fleet.WaitForPrefix("ready", kFleetPatience)) << fleet.Log();
+
+  std::vector<std::string> top = {PROGRAM_CANFLEET_TOP};
+  for (auto& a : DdsArgs(91))
+    top.push_back(a);
+  for (std::string a : {"--once", "--height", "150", "--color", "never", "--wait", "30"})
+    top.push_back(a);
+  ChildProcess tool(top, dir.File("top.log"));
+  ASSERT_EQ(tool.Wait(kFleetPatience), std::optional<int>(0)) << tool.Log();
+  tool.Poll();
+  int rows = 0;
+  for (const auto& line : tool.Lines()) {
+    if (line.rfind("big0 ", 0) == 0 && line.find("kbit/s") == std::string::npos) ++rows;
+  }
+  EXPECT_EQ(rows, 127);
+}
+
+}  // namespace
+}  // namespace canfleet::system_test

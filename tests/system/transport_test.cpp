@@ -1,0 +1,324 @@
+// BrokerServer and BrokerClientPort in one process, over real sockets on one io_context (issue 4,
+// "Node <-> broker protocol"): batching, controller events, reconnection, refusals, deadlines,
+// and the lifetime rules of style.md ("Asio lifetimes").
+#include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <asio/io_context.hpp>
+#include <atomic>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "bus/broker_client/broker_client_port.hpp"
+#include "bus/wire/message_writer.hpp"
+#include "bus/wire/stream_decoder.hpp"
+#include "clock/asio_scheduler.hpp"
+#include "orchestrator/broker/broker.hpp"
+#include "orchestrator/transport/broker_server.hpp"
+#include "tests/system/support/child_process.hpp"
+
+namespace canfleet::system_test {
+namespace {
+
+using namespace std::chrono_literals;
+
+/// Captures spdlog output for the duration of a test.
+class LogCapture {
+ public:
+  LogCapture() : previous_(spdlog::default_logger()) {
+    auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(stream_);
+    spdlog::set_default_logger(std::make_shared<spdlog::logger>("capture", sink));
+    spdlog::set_level(spdlog::level::debug);
+  }
+  ~LogCapture() { spdlog::set_default_logger(previous_); }
+  std::string Text() const { return stream_.str(); }
+
+ private:
+  std::ostringstream stream_;
+  std::shared_ptr<spdlog::logger> previous_;
+};
+
+class Transport : public ::testing::Test {
+ protected:
+  Transport() { broker_.AddBus({.name = "can0", .bitrate = 1'000'000, .paced = true}); }
+
+  /// Runs the io_context until `condition` holds (or the patience runs out).
+  bool RunUntil(const std::function<bool()>& condition, std::chrono::milliseconds timeout = kPatience) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (!condition()) {
+      if (std::chrono::steady_clock::now() >= deadline) return false;
+      io_.restart();
+      io_.run_for(5ms);
+    }
+    return true;
+  }
+
+  std::string Listen(transport::BrokerServer& server) {
+    return server.Listen(wire::Endpoint::Parse("unix://" + dir_.File("t.sock"))).ToString();
+  }
+
+  std::unique_ptr<BrokerClientPort> Client(const std::string& endpoint, const std::string& name,
+                                           const std::string& bus = "can0") {
+    BrokerClientOptions options;
+    options.endpoint = endpoint;
+    options.bus = bus;
+    options.node_name = name;
+    return std::make_unique<BrokerClientPort>(io_, options);
+  }
+
+  TempDir dir_;
+  asio::io_context io_;
+  AsioScheduler scheduler_{io_};
+  broker::Broker broker_{scheduler_};
+};
+
+TEST_F(Transport, ManySendsInOneTurnLeaveInOneWrite) {
+  // "Send() appends to an outgoing batch flushed once per io_context turn": 1000 frames sent from
+  // one handler are one socket write.
+  transport::BrokerServer server(io_, broker_);
+  broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false});
+  const std::string ep = Listen(server);
+  auto a = Client(ep, "a", "fast");
+  auto b = Client(ep, "b", "fast");
+  std::vector<std::pair<CanFrame, BusTime>> got;
+  b->OnReceive([&](const CanFrame& f, BusTime t) { got.emplace_back(f, t); });
+  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b->Connected(); }));
+  ASSERT_TRUE(RunUntil([&] { return a->Stats().writes >= 1; }));  // the Hello has left
+  const auto writes_before = a->Stats().writes;
+  asio::post(io_, [&] {
+    for (std::uint32_t i = 0; i < 1000; ++i)
+      ASSERT_TRUE(a->Send(CanFrame::Data(0x100 + (i % 16), {std::uint8_t(i), std::uint8_t(i >> 8)})));
+  });
+  ASSERT_TRUE(RunUntil([&] { return got.size() >= 1000; })) << got.size();
+  EXPECT_EQ(a->Stats().writes - writes_before, 1u);
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(got[i].first.data[0] | got[i].first.data[1] << 8, static_cast<int>(i));
+    if (i > 0) {
+      ASSERT_GE(got[i].second, got[i - 1].second);
+    }
+  }
+}
+
+TEST_F(Transport, ControllerEventsReachTheNode) {
+  // A node alone on a paced bus gets ACK errors and goes error-passive (ISO 11898-1 §12.1.4,
+  // rule 3 exception 1); the event reaches OnStateChange and State(). Over TCP.
+  transport::BrokerServer server(io_, broker_);
+  const wire::Endpoint tcp = server.Listen(wire::Endpoint::Parse("tcp://127.0.0.1:0"));
+  ASSERT_NE(tcp.port, 0);
+  auto a = Client(tcp.ToString(), "alone");
+  std::vector<ControllerEvent> events;
+  a->OnStateChange([&](const ControllerEvent& e) { events.push_back(e); });
+  ASSERT_TRUE(RunUntil([&] { return a->Connected(); }));
+  ASSERT_TRUE(a->Send(CanFrame::Data(0x181, {1})));
+  ASSERT_TRUE(RunUntil([&] { return !events.empty(); }));
+  EXPECT_EQ(events[0].state, ControllerState::kErrorPassive);
+  EXPECT_EQ(events[0].tec, 128);
+  EXPECT_EQ(a->State(), ControllerState::kErrorPassive);
+}
+
+TEST_F(Transport, SendFailsWhileNoBrokerListens) {
+  // An unplugged cable: frames are refused, attempts keep failing, nothing crashes.
+  LogCapture log;
+  auto a = Client("unix://" + dir_.File("nobody.sock"), "a");
+  EXPECT_FALSE(a->Send(CanFrame::Data(0x181, {1})));
+  ASSERT_TRUE(RunUntil([&] { return a->Stats().failed_attempts >= 2; }));
+  EXPECT_FALSE(a->Connected());
+  EXPECT_FALSE(a->Session());
+  EXPECT_FALSE(a->Send(CanFrame::Data(0x181, {1})));
+  EXPECT_NE(log.Text().find("retrying in 200 ms"), std::string::npos) << log.Text();
+}
+
+TEST_F(Transport, ReconnectsToANewServerAndIsANewController) {
+  auto server = std::make_unique<transport::BrokerServer>(io_, broker_);
+  const std::string ep = Listen(*server);
+  auto a = Client(ep, "a");
+  std::vector<std::string> connection;
+  a->OnConnection(
+      [&](bool up, const std::string& detail) { connection.push_back((up ? "up " : "down ") + detail); });
+  ASSERT_TRUE(RunUntil([&] { return a->Connected(); }));
+  const auto first_port = a->Session()->port_id;
+  EXPECT_EQ(broker_.Ports("can0").size(), 1u);
+
+  server.reset();  // the broker goes away: the port is detached, the client told why
+  EXPECT_EQ(broker_.Ports("can0").size(), 0u);
+  ASSERT_TRUE(RunUntil([&] { return connection.size() == 2; }));
+  EXPECT_EQ(connection[1], "down the broker closed the connection: broker shutting down");
+  EXPECT_FALSE(a->Send(CanFrame::Data(0x181, {1})));
+
+  server = std::make_unique<transport::BrokerServer>(io_, broker_);
+  Listen(*server);
+  ASSERT_TRUE(RunUntil([&] { return connection.size() == 3; }));
+  EXPECT_TRUE(connection[2].starts_with("up unix://")) << connection[2];
+  EXPECT_NE(a->Session()->port_id, first_port);
+  EXPECT_EQ(a->Stats().connects, 2u);
+  EXPECT_EQ(a->Stats().disconnects, 1u);
+}
+
+TEST_F(Transport, RefusalIsLoggedOnBothSides) {
+  LogCapture log;
+  transport::BrokerServer server(io_, broker_);
+  auto a = Client(Listen(server), "a", "nosuch");
+  std::vector<std::string> connection;
+  a->OnConnection(
+      [&](bool up, const std::string& detail) { connection.push_back((up ? "up " : "down ") + detail); });
+  ASSERT_TRUE(RunUntil([&] { return server.Stats().refused >= 1 && !connection.empty(); }));
+  // The node process is told, so it can give up.
+  EXPECT_EQ(connection[0], "down refused: unknown bus nosuch (this broker has: can0)");
+  const std::string text = log.Text();
+  // The broker's side...
+  EXPECT_NE(text.find("closed: refused: unknown bus nosuch (this broker has: can0)"), std::string::npos)
+      << text;
+  // ...and the node's.
+  EXPECT_NE(text.find("refused bus nosuch: unknown bus nosuch (this broker has: can0)"), std::string::npos)
+      << text;
+  EXPECT_FALSE(a->Connected());
+}
+
+TEST_F(Transport, ConnectionWithoutHelloIsClosedAfterTheDeadline) {
+  transport::BrokerServer server(io_, broker_, {.hello_timeout = 200ms});
+  const std::string ep = Listen(server);
+  std::unique_ptr<RawConnection> raw;
+  std::thread peer([&] {
+    raw = std::make_unique<RawConnection>(ep);
+    auto got = raw->ReadUntilClosed();
+    wire::StreamDecoder d;
+    d.Feed(got.bytes);
+    wire::Message m;
+    ASSERT_EQ(d.Next(m), wire::StreamDecoder::Result::kMessage);
+    EXPECT_EQ(m.envelope.error().reason(), "no Hello within 200 ms");
+    EXPECT_TRUE(got.closed);
+  });
+  ASSERT_TRUE(RunUntil([&] { return server.Stats().protocol_errors == 1 && server.SessionCount() == 0; }))
+      << "protocol errors " << server.Stats().protocol_errors << ", sessions " << server.SessionCount()
+      << ", accepted " << server.Stats().accepted;
+  peer.join();
+}
+
+TEST_F(Transport, DisconnectDetachesThePort) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  auto a = Client(ep, "a");
+  auto b = Client(ep, "b");
+  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b->Connected(); }));
+  EXPECT_EQ(broker_.Ports("can0").size(), 2u);
+  a.reset();
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("can0").size() == 1 && server.SessionCount() == 1; }));
+  EXPECT_EQ(broker_.Ports("can0")[0].name, "b");
+}
+
+TEST_F(Transport, AHandlerMayDestroyItsPort) {
+  // "a handler may destroy the port": the rest of the batch is dropped, nothing is touched after.
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  auto a = Client(ep, "a");
+  auto b = Client(ep, "b");
+  int calls = 0;
+  b->OnReceive([&](const CanFrame&, BusTime) {
+    ++calls;
+    b.reset();
+  });
+  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b && b->Connected(); }));
+  for (int i = 0; i < 10; ++i)
+    a->Send(CanFrame::Data(0x181, {std::uint8_t(i)}));
+  ASSERT_TRUE(RunUntil([&] { return b == nullptr; }));
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("can0").size() == 1; }));
+  EXPECT_EQ(calls, 1);
+}
+
+TEST_F(Transport, MonitorSeesFramesAndErrorFramesButCannotSend) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  BrokerClientOptions options;
+  options.endpoint = ep;
+  options.node_name = "capture";
+  options.monitor = true;
+  BrokerClientPort monitor(io_, options);
+  std::vector<std::string> seen;
+  monitor.OnReceive(
+      [&](const CanFrame& f, BusTime) { seen.push_back(ToCandump(f) + (f.error() ? "!" : "")); });
+  auto a = Client(ep, "a");
+  ASSERT_TRUE(RunUntil([&] { return a->Connected() && monitor.Connected(); }));
+  EXPECT_FALSE(monitor.Send(CanFrame::Data(0x100, {1})));
+  // A alone (the monitor does not acknowledge): ACK errors, seen as error frames.
+  a->Send(CanFrame::Data(0x181, {0xAA}));
+  ASSERT_TRUE(RunUntil([&] { return !seen.empty(); }));
+  EXPECT_EQ(seen[0], "181#!");
+  auto b = Client(ep, "b");  // an acknowledger: the frame finally goes through
+  ASSERT_TRUE(RunUntil([&] { return std::find(seen.begin(), seen.end(), "181#AA") != seen.end(); }));
+}
+
+/// A PortSink for a port driven from the test itself.
+struct NullSink : broker::PortSink {
+  void Deliver(std::span<const broker::TimedFrame>) override {}
+  void ControllerChanged(const ControllerEvent&) override {}
+};
+
+TEST_F(Transport, ASlowReaderLosesFramesAndNobodyElseDoes) {
+  // A node that stops reading is not allowed to make the broker buffer without bound: beyond
+  // ServerOptions::max_backlog_bytes its deliveries are dropped and counted; the others go on.
+  LogCapture log;
+  broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false, .tx_queue_capacity = 1 << 20});
+  transport::BrokerServer server(io_, broker_, {.max_backlog_bytes = 64 * 1024});
+  const std::string ep = Listen(server);
+  RawConnection sleeper(ep);  // says Hello, then never reads
+  wire::MessageWriter hello;
+  hello.AddHello(wire::MakeHello("fast", "sleeper"));
+  ASSERT_TRUE(sleeper.Send(std::vector<std::uint8_t>(hello.Bytes().begin(), hello.Bytes().end())));
+  auto reader = Client(ep, "reader", "fast");
+  std::size_t read = 0;
+  reader->OnReceive([&](const CanFrame&, BusTime) { ++read; });
+  ASSERT_TRUE(RunUntil([&] { return reader->Connected() && broker_.Ports("fast").size() == 2; }));
+  NullSink sink;
+  const broker::PortId sender = broker_.Attach("fast", "sender", sink);
+  constexpr std::size_t kFrames = 100'000;  // 2.4 MB of records: far beyond socket buffers + 64 KiB
+  std::vector<CanFrame> burst(1000, CanFrame::Data(0x181, {1, 2, 3, 4, 5, 6, 7, 8}));
+  for (std::size_t sent = 0; sent < kFrames; sent += burst.size()) {
+    broker_.Submit(sender, burst);
+    ASSERT_TRUE(RunUntil([&] { return read >= sent + burst.size(); })) << read;
+  }
+  EXPECT_EQ(read, kFrames);
+  EXPECT_GT(server.Stats().backlog_drops, 0u);
+  EXPECT_LT(server.Stats().backlog_drops, kFrames);
+  EXPECT_NE(log.Text().find("[sleeper on fast, port 1]: not reading; dropping frames for it"),
+            std::string::npos)
+      << "log (" << log.Text().size() << " bytes):\n"
+      << log.Text();
+}
+
+TEST_F(Transport, BrokerAnswersPing) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  std::vector<wire::Message> replies;  // written by the peer thread until `done`
+  std::atomic<bool> done = false;
+  std::thread peer([&] {
+    RawConnection raw(ep);
+    wire::MessageWriter w;
+    w.AddPing(7);  // allowed before Hello, like a liveness probe
+    w.AddHello(wire::MakeHello("can0", "pinger"));
+    w.AddPing(8);
+    raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+    wire::StreamDecoder decoder;
+    wire::Message m;
+    while (replies.size() < 3) {
+      const auto got = raw.ReadAtLeast(1);
+      if (got.bytes.empty()) break;
+      decoder.Feed(got.bytes);
+      while (decoder.Next(m) == wire::StreamDecoder::Result::kMessage)
+        replies.push_back(m);
+    }
+    done = true;
+  });
+  ASSERT_TRUE(RunUntil([&] { return done.load(); }));
+  peer.join();
+  ASSERT_EQ(replies.size(), 3u);
+  EXPECT_EQ(replies[0].type, wire::MessageType::kPong);
+  EXPECT_EQ(replies[0].envelope.pong().nonce(), 7u);
+  EXPECT_EQ(replies[1].type, wire::MessageType::kHelloReply);
+  EXPECT_TRUE(replies[1].envelope.hello_reply().accepted());
+  EXPECT_EQ(replies[2].envelope.pong().nonce(), 8u);
+}
+
+}  // namespace
+}  // namespace canfleet::system_test

@@ -1,0 +1,157 @@
+// FleetView: the monitor's model and the events derived from status changes.
+#include "tools/telemetry/fleet_view.hpp"
+
+#include <gtest/gtest.h>
+
+namespace canfleet::tools {
+namespace {
+
+using namespace std::chrono_literals;
+using telemetry::ControllerState;
+using telemetry::HeartbeatConsumerState;
+using telemetry::NmtState;
+
+const WallTime kStart = WallTime(1'700'000'000s);
+
+NodeStatusSample Status(std::uint8_t node, NmtState state = NmtState::kOperational) {
+  NodeStatusSample s;
+  s.bus = "can0";
+  s.node_id = node;
+  s.device = "quad";
+  s.nmt_state = state;
+  s.publish_period = 1s;
+  return s;
+}
+
+SampleMeta At(WallTime time) {
+  return {.source_time = time};
+}
+
+TEST(FleetView, FirstStatusIsSeenThenChangesAreEvents) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  view.Apply(Status(5, NmtState::kPreOperational), At(kStart + 1s), &events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kNodeSeen);
+  events.clear();
+
+  NodeStatusSample s = Status(5, NmtState::kOperational);
+  s.controller_state = ControllerState::kErrorPassive;
+  s.error_register = 0x11;
+  view.Apply(s, At(kStart + 2s), &events);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].kind, EventKind::kNmt);
+  EXPECT_EQ(events[0].from, "PREOP");
+  EXPECT_EQ(events[0].to, "OPER");
+  EXPECT_EQ(events[1].kind, EventKind::kController);
+  EXPECT_EQ(events[1].to, "passive");
+  EXPECT_EQ(events[2].kind, EventKind::kErrorRegister);
+  EXPECT_EQ(events[2].from, "00h");
+  EXPECT_EQ(events[2].to, "11h");
+  EXPECT_EQ(view.nodes().at({"can0", 5}).last_change, kStart + 2s);
+}
+
+TEST(FleetView, AnUnchangedStatusIsNoEvent) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  view.Apply(Status(1), At(kStart + 1s), nullptr);
+  NodeStatusSample s = Status(1);
+  s.rpdo_count = 100;
+  view.Apply(s, At(kStart + 2s), &events);
+  EXPECT_TRUE(events.empty());
+  EXPECT_EQ(view.nodes().at({"can0", 1}).status.rpdo_count, 100u);
+}
+
+TEST(FleetView, HeartbeatConsumerTimeoutIsAnEventNamingThePeer) {
+  FleetView view(kStart);
+  NodeStatusSample s = Status(2);
+  s.heartbeat_consumers = {{1, 250, HeartbeatConsumerState::kActive, NmtState::kOperational}};
+  view.Apply(s, At(kStart + 1s), nullptr);
+  s.heartbeat_consumers[0].state = HeartbeatConsumerState::kTimedOut;
+  std::vector<FleetEvent> events;
+  view.Apply(s, At(kStart + 2s), &events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kHeartbeatConsumer);
+  EXPECT_EQ(events[0].peer_node, 1);
+  EXPECT_EQ(events[0].to, "timed-out");
+  EXPECT_TRUE(IsFaulted(view.nodes().at({"can0", 2}), kStart + 2s));
+}
+
+TEST(FleetView, DisposeMeansGoneAndTheNextStatusMeansBack) {
+  FleetView view(kStart);
+  view.Apply(Status(3), At(kStart + 1s), nullptr);
+  std::vector<FleetEvent> events;
+  view.Apply(Status(3), {.source_time = kStart + 2s, .valid_data = false, .alive = false, .disposed = true},
+             &events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kNodeGone);
+  EXPECT_EQ(events[0].to, "disposed");
+  EXPECT_FALSE(view.nodes().at({"can0", 3}).alive);
+  events.clear();
+  view.Apply(Status(3), At(kStart + 3s), &events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kNodeSeen);
+  EXPECT_EQ(events[0].from, "gone");
+}
+
+TEST(FleetView, EventsOlderThanTheMonitorAreReplays) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  EmcySample emcy{.bus = "can0", .node_id = 4, .emcy = {.code = 0x8130}};
+  view.Apply(emcy, At(kStart - 5s), &events);
+  view.Apply(emcy, At(kStart + 5s), &events);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_TRUE(events[0].replay);
+  EXPECT_FALSE(events[1].replay);
+}
+
+TEST(FleetView, AnEmcyBeforeTheNodesFirstStatusIsKept) {
+  // Readers deliver topic by topic: the EMCY may arrive before the node's status.
+  FleetView view(kStart);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x8120}}, At(kStart + 1s), nullptr);
+  view.Apply(Status(6), At(kStart + 1s), nullptr);
+  const NodeRow& row = view.nodes().at({"can0", 6});
+  ASSERT_TRUE(row.last_emcy.has_value());
+  EXPECT_EQ(row.last_emcy->emcy.code, 0x8120);
+}
+
+TEST(FleetView, RecentEventsAreInTimeOrderWhateverTheArrivalOrder) {
+  FleetView view(kStart);
+  view.Apply(FaultEventSample{.bus = "can0", .fault_id = 1}, At(kStart + 2s), nullptr);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 1}, At(kStart + 1s), nullptr);
+  ASSERT_EQ(view.recent().size(), 2u);
+  EXPECT_EQ(view.recent()[0].kind, EventKind::kEmcy);
+  EXPECT_EQ(view.recent()[1].kind, EventKind::kFault);
+}
+
+TEST(FleetView, FaultsAreActiveUntilCleared) {
+  FleetView view(kStart);
+  FaultEventSample fault{
+      .bus = "can1", .fault_id = 9, .action = telemetry::FaultAction::kInjected, .kind = "drop"};
+  view.Apply(fault, At(kStart + 1s), nullptr);
+  EXPECT_EQ(view.buses().at("can1").active_faults.size(), 1u);
+  fault.action = telemetry::FaultAction::kCleared;
+  view.Apply(fault, At(kStart + 2s), nullptr);
+  EXPECT_TRUE(view.buses().at("can1").active_faults.empty());
+}
+
+TEST(FleetView, SilenceForThreePeriodsIsStale) {
+  FleetView view(kStart);
+  view.Apply(Status(7), At(kStart), nullptr);
+  const NodeRow& row = view.nodes().at({"can0", 7});
+  EXPECT_FALSE(IsStale(row, kStart + 2s));
+  EXPECT_TRUE(IsStale(row, kStart + 4s));
+  EXPECT_TRUE(IsFaulted(row, kStart + 4s));
+}
+
+TEST(EventKind, NamesRoundTrip) {
+  for (auto kind :
+       {EventKind::kNodeSeen, EventKind::kNodeGone, EventKind::kNmt, EventKind::kController,
+        EventKind::kErrorRegister, EventKind::kHeartbeatConsumer, EventKind::kEmcy, EventKind::kFault}) {
+    EXPECT_EQ(ParseEventKind(ToString(kind)), kind);
+  }
+  EXPECT_EQ(ParseEventKind("nope"), std::nullopt);
+}
+
+}  // namespace
+}  // namespace canfleet::tools

@@ -1,0 +1,187 @@
+// `canfleet top`: row selection, ordering, paging and the rendered screen.
+#include "tools/telemetry/top_format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+namespace canfleet::tools {
+namespace {
+
+using namespace std::chrono_literals;
+using telemetry::ControllerState;
+using telemetry::NmtState;
+
+const WallTime kNow = WallTime(1'700'000'000s);
+
+SampleMeta At(WallTime t) {
+  return {.source_time = t};
+}
+
+NodeStatusSample Status(const std::string& bus, std::uint8_t node, NmtState state = NmtState::kOperational) {
+  NodeStatusSample s;
+  s.bus = bus;
+  s.node_id = node;
+  s.device = node % 2 ? "quad-controller" : "valve-12in12out";
+  s.nmt_state = state;
+  s.publish_period = 1s;
+  s.uptime = 3723s;
+  return s;
+}
+
+std::vector<int> Ids(const std::vector<const NodeRow*>& rows) {
+  std::vector<int> ids;
+  for (const NodeRow* row : rows)
+    ids.push_back(row->status.node_id);
+  return ids;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    lines.push_back(line);
+  return lines;
+}
+
+class TopFormat : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    view_.Apply(Status("can0", 3), At(kNow - 100s), nullptr);
+    view_.Apply(Status("can0", 1, NmtState::kPreOperational), At(kNow - 100s), nullptr);
+    NodeStatusSample busoff = Status("can1", 2);
+    busoff.controller_state = ControllerState::kBusOff;
+    busoff.tec = 256;
+    view_.Apply(Status("can1", 2), At(kNow - 100s), nullptr);
+    view_.Apply(busoff, At(kNow - 1s), nullptr);  // changed just now
+    NodeStatusSample passive = Status("can0", 4, NmtState::kStopped);
+    passive.controller_state = ControllerState::kErrorPassive;
+    passive.tec = 130;
+    view_.Apply(passive, At(kNow - 50s), nullptr);
+    // Periodic republications since (no change): every node is current, not stale.
+    const auto nodes = view_.nodes();
+    for (const auto& [key, row] : nodes)
+      view_.Apply(row.status, At(kNow - 500ms), nullptr);
+  }
+  FleetView view_{kNow - 200s};
+};
+
+TEST_F(TopFormat, DefaultOrderIsBusThenNode) {
+  EXPECT_EQ(Ids(SelectRows(view_, {}, SortKey::kBusNode, false, kNow)), (std::vector<int>{1, 3, 4, 2}));
+  EXPECT_EQ(Ids(SelectRows(view_, {}, SortKey::kBusNode, true, kNow)), (std::vector<int>{2, 4, 3, 1}));
+}
+
+TEST_F(TopFormat, SortByStateHealthiestFirstAndByErrorsWorstFirst) {
+  EXPECT_EQ(Ids(SelectRows(view_, {}, SortKey::kState, false, kNow)), (std::vector<int>{3, 1, 4, 2}));
+  EXPECT_EQ(Ids(SelectRows(view_, {}, SortKey::kErrors, false, kNow)).front(), 2);  // bus-off
+  EXPECT_EQ(Ids(SelectRows(view_, {}, SortKey::kLastChange, false, kNow)).front(), 2);
+}
+
+TEST_F(TopFormat, FiltersByBusStateAndText) {
+  EXPECT_EQ(Ids(SelectRows(view_, {.bus = "can1"}, SortKey::kBusNode, false, kNow)), (std::vector<int>{2}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.state = "preop"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{1}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.state = "passive"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{4}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.state = "fault"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{2}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.state = "ok"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{1, 3, 4}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.text = "VALVE"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{4, 2}));
+  EXPECT_EQ(Ids(SelectRows(view_, {.text = "can0 #3"}, SortKey::kBusNode, false, kNow)),
+            (std::vector<int>{3}));
+}
+
+TEST_F(TopFormat, StateFilterWordsAreValidated) {
+  EXPECT_TRUE(IsValidStateFilter("OPER"));
+  EXPECT_TRUE(IsValidStateFilter("bus-off"));
+  EXPECT_TRUE(IsValidStateFilter(""));
+  EXPECT_FALSE(IsValidStateFilter("running"));
+}
+
+TEST_F(TopFormat, PlainFrameHasNoEscapesAndOneLinePerNode) {
+  RenderSettings settings{.color = false, .now = kNow};
+  const std::string frame = RenderFrame(view_, settings);
+  EXPECT_EQ(frame.find('\x1b'), std::string::npos);
+  const auto lines = Lines(frame);
+  EXPECT_NE(lines[0].find("4 nodes on 2 buses, 1 faulted, 4 shown"), std::string::npos);
+  const auto count = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.rfind("can0 ", 0) == 0 || l.rfind("can1 ", 0) == 0;
+  });
+  EXPECT_EQ(count, 4 + 2);  // node rows and bus lines
+  EXPECT_NE(frame.find("bus-off"), std::string::npos);
+  EXPECT_NE(frame.find("1:02:03"), std::string::npos);  // uptime 3723 s
+}
+
+TEST_F(TopFormat, ColorFrameMarksFaultsRedAndFreshChangesReversed) {
+  RenderSettings settings{.color = true, .now = kNow};
+  const auto lines = Lines(RenderFrame(view_, settings));
+  const auto row = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find("can1       2") != std::string::npos;
+  });
+  ASSERT_NE(row, lines.end());
+  EXPECT_NE(row->find("\x1b[31m"), std::string::npos);  // red: bus-off
+  EXPECT_NE(row->find("\x1b[7m"), std::string::npos);   // reversed: changed within 5 s
+  const auto quiet = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find("can0       3") != std::string::npos;
+  });
+  ASSERT_NE(quiet, lines.end());
+  EXPECT_EQ(quiet->find('\x1b'), std::string::npos);  // healthy and quiet: plain
+}
+
+TEST(TopPaging, A127NodeBusPagesWithinTheScreen) {
+  FleetView view(kNow - 10s);
+  for (std::uint8_t id = 1; id <= 127; ++id)
+    view.Apply(Status("can0", id), At(kNow - 1s), nullptr);
+  RenderSettings settings{.width = 120, .height = 40, .color = false, .now = kNow};
+  const int per_page = RowsPerPage(settings, 1);
+  const int pages = PageCount(127, per_page);
+  EXPECT_EQ(pages, (127 + per_page - 1) / per_page);
+  std::set<std::string> seen;
+  for (int page = 0; page < pages; ++page) {
+    settings.page = page;
+    const auto lines = Lines(RenderFrame(view, settings));
+    EXPECT_LE(static_cast<int>(lines.size()), settings.height);
+    for (const auto& line : lines) {
+      EXPECT_LE(static_cast<int>(line.size()), settings.width);
+      if (line.rfind("can0 ", 0) == 0 && line.find("nodes 127") == std::string::npos)
+        seen.insert(line.substr(0, 13));
+    }
+  }
+  EXPECT_EQ(seen.size(), 127u);  // every node on exactly one page
+  settings.page = 99;            // past the end: the last page
+  EXPECT_NE(RenderFrame(view, settings).find(" page " + std::to_string(pages) + "/"), std::string::npos);
+}
+
+TEST(TopPaging, OneScreenShows127NodesWhenTallEnough) {
+  FleetView view(kNow - 10s);
+  for (std::uint8_t id = 1; id <= 127; ++id)
+    view.Apply(Status("can0", id), At(kNow - 1s), nullptr);
+  RenderSettings settings{.height = 140, .color = false, .now = kNow};
+  EXPECT_NE(RenderFrame(view, settings).find("page 1/1"), std::string::npos);
+}
+
+TEST(TopText, UptimeAndAgeFormats) {
+  EXPECT_EQ(FormatUptime(3723s), "1:02:03");
+  EXPECT_EQ(FormatUptime(std::chrono::hours(76)), "3d04h");
+  EXPECT_EQ(FormatAge(400ms), "0.4s");
+  EXPECT_EQ(FormatAge(42s), "42s");
+  EXPECT_EQ(FormatAge(5min), "5m");
+  EXPECT_EQ(FormatAge(3h), "3h");
+}
+
+TEST(TopText, SortKeysCycleAndParse) {
+  SortKey key = SortKey::kBusNode;
+  std::set<SortKey> seen;
+  for (int i = 0; i < 5; ++i) {
+    seen.insert(key);
+    EXPECT_EQ(ParseSortKey(ToString(key)), key);
+    key = NextSortKey(key);
+  }
+  EXPECT_EQ(seen.size(), 5u);
+  EXPECT_EQ(key, SortKey::kBusNode);
+}
+
+}  // namespace
+}  // namespace canfleet::tools

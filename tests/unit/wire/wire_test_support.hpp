@@ -1,0 +1,91 @@
+#pragma once
+// Helpers shared by the wire codec tests.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bus/can_frame.hpp"
+#include "bus/wire/message_writer.hpp"
+#include "bus/wire/stream_decoder.hpp"
+#include "tests/support/bus_probe.hpp"
+
+namespace canfleet::wire::test {
+
+using Bytes = std::vector<std::uint8_t>;
+
+inline Bytes ToBytes(std::span<const std::uint8_t> s) {
+  return Bytes(s.begin(), s.end());
+}
+inline Bytes ToBytes(const std::string& s) {
+  return Bytes(s.begin(), s.end());
+}
+
+/// A decoded message reduced to comparable text, e.g. "Frames 123#DEADBEEF@5 7FF#R@9".
+inline std::string Describe(const Message& m) {
+  std::string out = ToString(m.type);
+  switch (m.type) {
+    case MessageType::kFrames:
+    case MessageType::kTxConfirm:
+      for (std::size_t i = 0; i < m.frames.size(); ++i) {
+        const StampedFrame f = m.frames[i];
+        out += " " + ToCandump(f.frame) + "@" + std::to_string(f.time.count());
+        if (f.frame.error()) out += "!";
+      }
+      break;
+    case MessageType::kControllerEvent:
+      out += std::string(" ") + canfleet::ToString(m.controller.state) + " " +
+             std::to_string(m.controller.tec) + " " + std::to_string(m.controller.rec);
+      break;
+    case MessageType::kHello:
+      out += " " + m.envelope.hello().ShortDebugString();
+      break;
+    case MessageType::kHelloReply:
+      out += " " + m.envelope.hello_reply().ShortDebugString();
+      break;
+    case MessageType::kPing:
+      out += " " + std::to_string(m.envelope.ping().nonce());
+      break;
+    case MessageType::kPong:
+      out += " " + std::to_string(m.envelope.pong().nonce());
+      break;
+    case MessageType::kError:
+      out += " " + m.envelope.error().reason();
+      break;
+  }
+  return out;
+}
+
+struct DecodeOutcome {
+  std::vector<std::string> messages;
+  bool failed = false;
+  std::string error;
+};
+
+/// Feeds `bytes` in chunks of `chunk` bytes (0 = all at once), decoding after each chunk.
+inline DecodeOutcome DecodeAll(std::span<const std::uint8_t> bytes, std::size_t chunk = 0,
+                               std::size_t max_message = kMaxMessageSize) {
+  StreamDecoder decoder(max_message);
+  Message message;
+  DecodeOutcome out;
+  if (chunk == 0) chunk = bytes.size() == 0 ? 1 : bytes.size();
+  for (std::size_t at = 0; at < bytes.size() && !out.failed; at += chunk) {
+    decoder.Feed(bytes.subspan(at, std::min(chunk, bytes.size() - at)));
+    for (;;) {
+      const auto result = decoder.Next(message);
+      if (result == StreamDecoder::Result::kNeedMore) break;
+      if (result == StreamDecoder::Result::kError) {
+        out.failed = true;
+        out.error = decoder.Error();
+        break;
+      }
+      out.messages.push_back(Describe(message));
+    }
+  }
+  return out;
+}
+
+using canfleet::test::Frame;
+
+}  // namespace canfleet::wire::test

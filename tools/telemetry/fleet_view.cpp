@@ -1,0 +1,220 @@
+#include "tools/telemetry/fleet_view.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <iterator>
+
+namespace canfleet::tools {
+
+using telemetry::ControllerState;
+using telemetry::FaultAction;
+using telemetry::HeartbeatConsumerState;
+
+const char* ToString(EventKind kind) {
+  switch (kind) {
+    case EventKind::kNodeSeen:
+      return "seen";
+    case EventKind::kNodeGone:
+      return "gone";
+    case EventKind::kNmt:
+      return "nmt";
+    case EventKind::kController:
+      return "controller";
+    case EventKind::kErrorRegister:
+      return "error-register";
+    case EventKind::kHeartbeatConsumer:
+      return "hb-consumer";
+    case EventKind::kEmcy:
+      return "emcy";
+    case EventKind::kFault:
+      return "fault";
+  }
+  return "?";
+}
+
+std::optional<EventKind> ParseEventKind(std::string_view text) {
+  for (auto kind :
+       {EventKind::kNodeSeen, EventKind::kNodeGone, EventKind::kNmt, EventKind::kController,
+        EventKind::kErrorRegister, EventKind::kHeartbeatConsumer, EventKind::kEmcy, EventKind::kFault}) {
+    if (text == ToString(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+std::string Hex2(unsigned value) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%02Xh", value & 0xFFu);
+  return text;
+}
+
+}  // namespace
+
+FleetView::FleetView(WallTime started, std::size_t recent_capacity)
+    : started_(started), recent_capacity_(recent_capacity) {}
+
+void FleetView::Emit(FleetEvent event, std::vector<FleetEvent>* events) {
+  event.replay = event.time < started_;
+  // Samples of different topics arrive in batches per topic: keep the list in time order.
+  auto at = recent_.end();
+  while (at != recent_.begin() && std::prev(at)->time > event.time)
+    --at;
+  recent_.insert(at, event);
+  while (recent_.size() > recent_capacity_)
+    recent_.pop_front();
+  if (events) events->push_back(std::move(event));
+}
+
+void FleetView::Apply(const NodeStatusSample& sample, const SampleMeta& meta,
+                      std::vector<FleetEvent>* events) {
+  const NodeKey key = sample.key();
+  auto it = nodes_.find(key);
+  if (!meta.valid_data) {  // instance state change only: the node left or died
+    if (it == nodes_.end() || !it->second.alive) return;
+    it->second.alive = false;
+    it->second.disposed = meta.disposed;
+    it->second.last_change = meta.source_time;
+    Emit({.time = meta.source_time,
+          .kind = EventKind::kNodeGone,
+          .bus = key.bus,
+          .node_id = key.node_id,
+          .from = "",
+          .to = meta.disposed ? "disposed" : "no-writers"},
+         events);
+    return;
+  }
+  if (it == nodes_.end()) {
+    NodeRow row;
+    row.status = sample;
+    row.last_sample = meta.source_time;
+    row.last_change = meta.source_time;
+    if (auto early = early_emcy_.find(key); early != early_emcy_.end()) {
+      row.last_emcy = early->second.first;
+      row.last_emcy_time = early->second.second;
+      early_emcy_.erase(early);
+    }
+    nodes_.emplace(key, std::move(row));
+    last_new_node_ = std::max(last_new_node_, std::chrono::system_clock::now());
+    Emit({.time = meta.source_time,
+          .kind = EventKind::kNodeSeen,
+          .bus = key.bus,
+          .node_id = key.node_id,
+          .from = "",
+          .to = telemetry::ShortName(sample.nmt_state)},
+         events);
+    return;
+  }
+  NodeRow& row = it->second;
+  const NodeStatusSample& old = row.status;
+  const auto event = [&](EventKind kind, std::string from, std::string to) {
+    row.last_change = meta.source_time;
+    Emit({.time = meta.source_time,
+          .kind = kind,
+          .bus = key.bus,
+          .node_id = key.node_id,
+          .from = std::move(from),
+          .to = std::move(to)},
+         events);
+  };
+  if (!row.alive) event(EventKind::kNodeSeen, "gone", telemetry::ShortName(sample.nmt_state));
+  if (old.nmt_state != sample.nmt_state) {
+    event(EventKind::kNmt, telemetry::ShortName(old.nmt_state), telemetry::ShortName(sample.nmt_state));
+  }
+  if (old.controller_state != sample.controller_state) {
+    event(EventKind::kController, telemetry::ShortName(old.controller_state),
+          telemetry::ShortName(sample.controller_state));
+  }
+  if (old.error_register != sample.error_register) {
+    event(EventKind::kErrorRegister, Hex2(old.error_register), Hex2(sample.error_register));
+  }
+  for (const auto& consumer : sample.heartbeat_consumers) {
+    const auto previous = std::find_if(old.heartbeat_consumers.begin(), old.heartbeat_consumers.end(),
+                                       [&](const auto& c) { return c.node_id == consumer.node_id; });
+    const HeartbeatConsumerState before =
+        previous == old.heartbeat_consumers.end() ? HeartbeatConsumerState::kUnknown : previous->state;
+    if (before != consumer.state) {
+      row.last_change = meta.source_time;
+      Emit({.time = meta.source_time,
+            .kind = EventKind::kHeartbeatConsumer,
+            .bus = key.bus,
+            .node_id = key.node_id,
+            .from = telemetry::ToString(before),
+            .to = telemetry::ToString(consumer.state),
+            .peer_node = consumer.node_id},
+           events);
+    }
+  }
+  row.status = sample;
+  row.alive = true;
+  row.disposed = false;
+  row.last_sample = meta.source_time;
+}
+
+void FleetView::Apply(const EmcySample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events) {
+  if (!meta.valid_data) return;
+  auto it = nodes_.find({sample.bus, sample.node_id});
+  if (it != nodes_.end()) {
+    it->second.last_emcy = sample;
+    it->second.last_emcy_time = meta.source_time;
+  } else {
+    early_emcy_.insert_or_assign(NodeKey{sample.bus, sample.node_id},
+                                 std::make_pair(sample, meta.source_time));
+  }
+  Emit({.time = meta.source_time,
+        .kind = EventKind::kEmcy,
+        .bus = sample.bus,
+        .node_id = sample.node_id,
+        .emcy = sample},
+       events);
+}
+
+void FleetView::Apply(const IoSnapshotSample& sample, const SampleMeta& meta, std::vector<FleetEvent>*) {
+  auto it = nodes_.find({sample.bus, sample.node_id});
+  if (it == nodes_.end()) return;  // I/O is shown with its node; the status arrives within a period
+  if (meta.valid_data) {
+    it->second.io = sample;
+  } else {
+    it->second.io.reset();
+  }
+}
+
+void FleetView::Apply(const BusStatsSample& sample, const SampleMeta& meta, std::vector<FleetEvent>*) {
+  if (!meta.valid_data) {
+    buses_[sample.bus].stats.reset();
+    return;
+  }
+  buses_[sample.bus].stats = sample;
+}
+
+void FleetView::Apply(const FaultEventSample& sample, const SampleMeta& meta,
+                      std::vector<FleetEvent>* events) {
+  if (!meta.valid_data) return;
+  BusRow& bus = buses_[sample.bus];
+  if (sample.action == FaultAction::kInjected) {
+    bus.active_faults[sample.fault_id] = sample;
+  } else {
+    bus.active_faults.erase(sample.fault_id);
+  }
+  Emit({.time = meta.source_time,
+        .kind = EventKind::kFault,
+        .bus = sample.bus,
+        .node_id = sample.target_node,
+        .fault = sample},
+       events);
+}
+
+bool IsStale(const NodeRow& row, WallTime now) {
+  const auto period = std::max<std::chrono::milliseconds>(row.status.publish_period, std::chrono::seconds(1));
+  return row.alive && now - row.last_sample > 3 * period;
+}
+
+bool IsFaulted(const NodeRow& row, WallTime now) {
+  if (!row.alive || IsStale(row, now)) return true;
+  const auto& s = row.status;
+  if (s.controller_state == ControllerState::kBusOff || s.error_register != 0) return true;
+  return std::any_of(s.heartbeat_consumers.begin(), s.heartbeat_consumers.end(),
+                     [](const auto& c) { return c.state == HeartbeatConsumerState::kTimedOut; });
+}
+
+}  // namespace canfleet::tools

@@ -1,0 +1,63 @@
+#pragma once
+/// @file The `canfleet top` screen: which rows, in which order, and how they are drawn (plain ANSI).
+/// Pure functions of a FleetView, so tests check them without DDS or a terminal.
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tools/telemetry/fleet_view.hpp"
+
+namespace canfleet::tools {
+
+enum class SortKey { kBusNode, kState, kErrors, kLastChange, kDevice };
+const char* ToString(SortKey key);
+std::optional<SortKey> ParseSortKey(std::string_view text);
+/// The next key in the order above (the `s` key cycles through them).
+SortKey NextSortKey(SortKey key);
+
+struct TopFilter {
+  std::string bus{};  ///< exact bus name; empty = all
+  /// NMT state ("OPER", "PREOP", "STOP", "INIT", case-insensitive), controller state ("active",
+  /// "passive", "bus-off"), or "fault" (IsFaulted) / "ok"; empty = all.
+  std::string state{};
+  std::string text{};  ///< case-insensitive substring of "bus #id device"; empty = all
+};
+
+/// True if the filter's `state` is one of the accepted words (for command-line validation).
+bool IsValidStateFilter(std::string_view state);
+bool Matches(const NodeRow& row, const TopFilter& filter, WallTime now);
+
+/// Rows that pass `filter`, ordered by `key` (ties by bus then node-id).
+std::vector<const NodeRow*> SelectRows(const FleetView& view, const TopFilter& filter, SortKey key,
+                                       bool reverse, WallTime now);
+
+struct RenderSettings {
+  TopFilter filter{};
+  SortKey sort = SortKey::kBusNode;
+  bool reverse = false;
+  int width = 132;
+  int height = 50;  ///< whole screen, header and footer included
+  int page = 0;     ///< clamped to the last page
+  bool color = true;
+  std::chrono::seconds highlight{5};  ///< how long changes and EMCYs stay highlighted
+  int event_lines = 5;                ///< recent events shown under the table
+  std::string filter_prompt{};        ///< shown when the user is typing a filter
+  WallTime now{};
+};
+
+/// Node rows that fit on one page of a screen of `height` lines with `bus_count` bus lines.
+int RowsPerPage(const RenderSettings& settings, int bus_count);
+int PageCount(std::size_t rows, int rows_per_page);
+
+/// The whole screen as text, lines separated by '\n', no cursor movement (the caller clears).
+std::string RenderFrame(const FleetView& view, const RenderSettings& settings);
+
+/// "1:02:03" or "3d04h".
+std::string FormatUptime(std::chrono::milliseconds uptime);
+/// "0.4s", "12s", "5m", "3h".
+std::string FormatAge(std::chrono::system_clock::duration age);
+
+}  // namespace canfleet::tools

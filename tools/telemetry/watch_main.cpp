@@ -1,0 +1,20 @@
+// canfleet-watch: standalone `canfleet watch` until the canfleet CLI calls RunWatch() itself.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "telemetry/dds.hpp"
+#include "tools/telemetry/watch.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Stream of fleet events (EMCY, NMT and controller changes, faults), one per line"};
+  canfleet::tools::WatchOptions options;
+  canfleet::tools::AddWatchOptions(app, options);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    return canfleet::tools::RunWatch(options);
+  } catch (const std::exception& e) {
+    std::cerr << "canfleet-watch: " << e.what() << '\n';
+    return 1;
+  }
+}
