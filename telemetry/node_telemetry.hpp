@@ -74,7 +74,7 @@ struct PublisherStats {
   std::uint64_t events_dropped = 0;  ///< queue full
 };
 
-class NodeTelemetry : private PublisherLoop {
+class NodeTelemetry final : private PublisherLoop {
  public:
   /// Creates the topics and writers (throws DdsError) and starts the publisher thread.
   /// Throws std::invalid_argument for a bus name or I/O list beyond the IDL bounds.

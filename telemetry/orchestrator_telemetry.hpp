@@ -62,7 +62,7 @@ struct OrchestratorTelemetryOptions {
   std::size_t fault_queue = 256;
 };
 
-class OrchestratorTelemetry : private PublisherLoop {
+class OrchestratorTelemetry final : private PublisherLoop {
  public:
   /// Creates topics and writers (throws DdsError) and starts the publisher thread.
   explicit OrchestratorTelemetry(const Participant& participant, OrchestratorTelemetryOptions options = {});

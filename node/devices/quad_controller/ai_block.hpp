@@ -83,7 +83,6 @@ class AiBlock {
   void Autozero(int ch);
   void ResetChannel(Channel& c);
 
-  canopen::CanopenStack& stack_;
   const QuadIo& io_;
   OdRef error_check_enable_;
   std::array<Refs, kInputs> refs_;
