@@ -42,8 +42,7 @@ bool Measures(OperatingMode mode) {
 
 }  // namespace
 
-AiBlock::AiBlock(canopen::CanopenStack& stack, Scheduler& scheduler, const QuadIo& io)
-    : io_(io) {
+AiBlock::AiBlock(canopen::CanopenStack& stack, Scheduler& scheduler, const QuadIo& io) : io_(io) {
   auto& od = stack.od();
   error_check_enable_ = OdRef(od, kAiErrorCheckEnable, 1);
   for (int ch = 0; ch < kInputs; ++ch) {
