@@ -4,6 +4,8 @@
 #   scripts/test.sh --sanitize   ASan+UBSan build, unit tests only
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# CI builds a fresh clone in a new folder each time: relative paths let ccache hit across clones.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 
 mode=full
 [ "${1:-}" = "--sanitize" ] && mode=sanitize
