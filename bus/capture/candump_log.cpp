@@ -1,5 +1,7 @@
 #include "bus/capture/candump_log.hpp"
 
+#include "bus/text_append.hpp"
+
 #include <cstdint>
 
 #include "bus/capture/socketcan_layout.hpp"
@@ -7,25 +9,7 @@
 namespace canfleet::capture {
 namespace {
 
-constexpr char kHex[] = "0123456789ABCDEF";
-
-void AppendHex(std::string& out, std::uint32_t value, int digits) {
-  for (int shift = (digits - 1) * 4; shift >= 0; shift -= 4)
-    out += kHex[(value >> shift) & 0xF];
-}
-
-void AppendDecimal(std::string& out, std::uint64_t value, int min_digits) {
-  char digits[20];
-  int n = 0;
-  do {
-    digits[n++] = static_cast<char>('0' + value % 10);
-    value /= 10;
-  } while (value != 0);
-  for (int i = n; i < min_digits; ++i)
-    out += '0';
-  while (n > 0)
-    out += digits[--n];
-}
+constexpr const char* kHex = kHexDigits;
 
 }  // namespace
 

@@ -1,12 +1,14 @@
 #include "orchestrator/socketcand/protocol.hpp"
 
+#include "bus/text_append.hpp"
+
 #include <array>
 #include <optional>
 
 namespace canfleet::socketcand {
 namespace {
 
-constexpr char kHex[] = "0123456789ABCDEF";
+constexpr const char* kHex = kHexDigits;
 
 bool IsSpace(char c) {
   return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
@@ -91,24 +93,6 @@ Command ParseFrame(const Fields& f, bool remote) {
   c.kind = remote ? CommandKind::kSendRtr : CommandKind::kSend;
   c.frame = frame;
   return c;
-}
-
-void AppendHex(std::string& out, std::uint32_t value, int digits) {
-  for (int shift = (digits - 1) * 4; shift >= 0; shift -= 4)
-    out += kHex[(value >> shift) & 0xF];
-}
-
-void AppendDecimal(std::string& out, std::uint64_t value, int min_digits) {
-  char digits[20];
-  int n = 0;
-  do {
-    digits[n++] = static_cast<char>('0' + value % 10);
-    value /= 10;
-  } while (value != 0);
-  for (int i = n; i < min_digits; ++i)
-    out += '0';
-  while (n > 0)
-    out += digits[--n];
 }
 
 void AppendId(std::string& out, const CanFrame& frame) {
