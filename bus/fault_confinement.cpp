@@ -1,5 +1,7 @@
 #include "bus/fault_confinement.hpp"
 
+#include <algorithm>
+
 namespace canfleet {
 
 std::optional<ControllerEvent> FaultConfinement::Update() {
@@ -18,7 +20,8 @@ std::optional<ControllerEvent> FaultConfinement::Update() {
 
 std::optional<ControllerEvent> FaultConfinement::OnTransmitSuccess() {
   if (state_ == ControllerState::kBusOff) return std::nullopt;
-  if (tec_ > 0) --tec_;
+  const std::uint16_t floor = hold_passive_ ? kErrorPassiveTec : 0;
+  if (tec_ > floor) --tec_;
   return Update();
 }
 
@@ -29,7 +32,7 @@ std::optional<ControllerEvent> FaultConfinement::OnTransmitError(TransmitError e
   return Update();
 }
 
-std::optional<ControllerEvent> FaultConfinement::OnReceiveSuccess() {
+std::optional<ControllerEvent> FaultConfinement::CountReceiveSuccess() {
   if (state_ == ControllerState::kBusOff) return std::nullopt;
   if (rec_ > 127)
     rec_ = 127;  // "a value between 119 and 127": we choose 127
@@ -46,9 +49,9 @@ std::optional<ControllerEvent> FaultConfinement::OnReceiveError() {
 
 std::optional<ControllerEvent> FaultConfinement::Recover() {
   if (state_ != ControllerState::kBusOff) return std::nullopt;
-  tec_ = 0;
+  tec_ = hold_passive_ ? kErrorPassiveTec : 0;
   rec_ = 0;
-  state_ = ControllerState::kErrorActive;
+  state_ = hold_passive_ ? ControllerState::kErrorPassive : ControllerState::kErrorActive;
   return Snapshot();
 }
 
@@ -57,6 +60,17 @@ std::optional<ControllerEvent> FaultConfinement::ForceBusOff() {
   tec_ = 256;
   state_ = ControllerState::kBusOff;
   return Snapshot();
+}
+
+std::optional<ControllerEvent> FaultConfinement::HoldErrorPassive(bool on) {
+  if (on == hold_passive_) return std::nullopt;
+  hold_passive_ = on;
+  if (state_ == ControllerState::kBusOff) return std::nullopt;  // Recover() applies the hold
+  if (on)
+    tec_ = std::max(tec_, kErrorPassiveTec);
+  else
+    tec_ = std::min(tec_, kReleasedTec);
+  return Update();
 }
 
 }  // namespace canfleet

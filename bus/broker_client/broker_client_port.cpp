@@ -86,6 +86,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
 
   ConnectionHandler on_connection;
   TxConfirmHandler on_tx_confirmed;
+  NodeRequestHandler on_node_request;
 
  private:
   enum class Phase : std::uint8_t { kIdle, kConnecting, kHandshake, kConnected, kWaiting, kStopped };
@@ -207,11 +208,31 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       case wire::MessageType::kError:
         Fail("the broker closed the connection: " + m.envelope.error().reason());
         return;
+      case wire::MessageType::kNodeRequest:
+        OnNodeRequest(m.envelope.node_request());
+        return;
       case wire::MessageType::kHello:
       case wire::MessageType::kHelloReply:
+      case wire::MessageType::kNodeReply:
         ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from the broker");
         return;
     }
+  }
+
+  void OnNodeRequest(const wire::NodeRequest& request) {
+    const std::uint64_t id = request.request_id();
+    wire::NodeReply reply;
+    if (on_node_request) {
+      const std::uint64_t gen = generation_;
+      reply = on_node_request(request);
+      if (gen != generation_ || owner_ == nullptr) return;  // the handler destroyed the port
+    } else {
+      reply.set_error((options_.node_name.empty() ? std::string("this client") : options_.node_name) +
+                      " serves no node requests");
+    }
+    reply.set_request_id(id);
+    filling_.AddNodeReply(reply);
+    ScheduleFlush();
   }
 
   void OnHelloReply(const wire::HelloReply& reply) {
@@ -379,6 +400,10 @@ void BrokerClientPort::OnConnection(ConnectionHandler handler) {
 
 void BrokerClientPort::OnTxConfirmed(TxConfirmHandler handler) {
   link_->on_tx_confirmed = std::move(handler);
+}
+
+void BrokerClientPort::OnNodeRequest(NodeRequestHandler handler) {
+  link_->on_node_request = std::move(handler);
 }
 
 const BrokerClientStats& BrokerClientPort::Stats() const {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "bus/bus_port.hpp"
+#include "bus/wire/canfleet_wire.pb.h"
 
 namespace canfleet {
 
@@ -74,6 +75,10 @@ class BrokerClientPort final : public BusPort {
   /// `detail`: "tcp://127.0.0.1:29600 bus can0 (500000 bit/s, paced), port 3" or why.
   using ConnectionHandler = std::function<void(bool connected, const std::string& detail)>;
   using TxConfirmHandler = std::function<void(const CanFrame&, BusTime)>;
+  /// Answers one request of the broker to this node (simulated I/O: NodeRequest.io_set / io_get).
+  /// Called on the io thread; the reply's request_id is filled in by the port. It may destroy the
+  /// port (then nothing is sent).
+  using NodeRequestHandler = std::function<wire::NodeReply(const wire::NodeRequest&)>;
 
   /// Throws std::invalid_argument on a malformed endpoint.
   BrokerClientPort(asio::io_context& io, BrokerClientOptions options);
@@ -92,6 +97,9 @@ class BrokerClientPort final : public BusPort {
 
   void OnConnection(ConnectionHandler handler);
   void OnTxConfirmed(TxConfirmHandler handler);
+  /// Serves the broker's NodeRequests. Without a handler the port answers each with the error
+  /// "<node name> serves no node requests", so the broker is not left waiting.
+  void OnNodeRequest(NodeRequestHandler handler);
 
   const BrokerClientStats& Stats() const;
 

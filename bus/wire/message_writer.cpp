@@ -95,6 +95,14 @@ void MessageWriter::AddError(std::string_view reason) {
   AppendProto([&](Envelope& e) { e.mutable_error()->set_reason(std::string(reason)); });
 }
 
+void MessageWriter::AddNodeRequest(const NodeRequest& request) {
+  AppendProto([&](Envelope& e) { *e.mutable_node_request() = request; });
+}
+
+void MessageWriter::AddNodeReply(const NodeReply& reply) {
+  AppendProto([&](Envelope& e) { *e.mutable_node_reply() = reply; });
+}
+
 void MessageWriter::Clear() {
   buffer_.clear();
   batch_open_ = false;

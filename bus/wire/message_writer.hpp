@@ -58,6 +58,8 @@ class MessageWriter {
   void AddPing(std::uint64_t nonce);
   void AddPong(std::uint64_t nonce);
   void AddError(std::string_view reason);
+  void AddNodeRequest(const NodeRequest& request);
+  void AddNodeReply(const NodeReply& reply);
 
   /// Closes the open batch, if any.
   void CloseBatch();

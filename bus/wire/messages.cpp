@@ -22,6 +22,10 @@ const char* ToString(MessageType type) {
       return "Pong";
     case MessageType::kError:
       return "Error";
+    case MessageType::kNodeRequest:
+      return "NodeRequest";
+    case MessageType::kNodeReply:
+      return "NodeReply";
   }
   return "unknown";
 }

@@ -20,7 +20,8 @@ namespace canfleet::wire {
 
 /// Bumped on any incompatible change of canfleet_wire.proto or of the record layout. A Hello with
 /// another version is refused with a reason naming both.
-inline constexpr std::uint32_t kProtocolVersion = 1;
+/// 2: NodeRequest / NodeReply.
+inline constexpr std::uint32_t kProtocolVersion = 2;
 
 /// Largest Envelope (without its length prefix). Longer = protocol error.
 inline constexpr std::size_t kMaxMessageSize = std::size_t{1} << 20;
@@ -40,7 +41,9 @@ enum class MessageType : std::uint8_t {
   kControllerEvent,
   kPing,
   kPong,
-  kError,  ///< the peer is about to close; envelope.error().reason() says why
+  kError,        ///< the peer is about to close; envelope.error().reason() says why
+  kNodeRequest,  ///< broker -> node: envelope.node_request()
+  kNodeReply,    ///< node -> broker: envelope.node_reply()
 };
 
 const char* ToString(MessageType type);
@@ -53,7 +56,8 @@ struct Message {
   FrameRecords frames;
   /// kControllerEvent, converted and range-checked.
   canfleet::ControllerEvent controller;
-  /// kHello, kHelloReply, kPing, kPong, kError: the parsed Envelope (envelope.hello(), ...).
+  /// kHello, kHelloReply, kPing, kPong, kError, kNodeRequest, kNodeReply: the parsed Envelope
+  /// (envelope.hello(), ...).
   Envelope envelope;
 };
 

@@ -216,6 +216,12 @@ bool StreamDecoder::DecodeEnvelope(std::span<const std::uint8_t> body, Message& 
     case Envelope::kError:
       out.type = MessageType::kError;
       return true;
+    case Envelope::kNodeRequest:
+      out.type = MessageType::kNodeRequest;
+      return true;
+    case Envelope::kNodeReply:
+      out.type = MessageType::kNodeReply;
+      return true;
     case Envelope::BODY_NOT_SET:
       break;
   }

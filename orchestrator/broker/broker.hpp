@@ -71,7 +71,9 @@ class Broker {
   std::size_t Submit(PortId port, const CanFrame& frame) { return Submit(port, std::span(&frame, 1)); }
 
   /// Bus-off recovery on command (like `ip link set can0 type can restart`): the port becomes
-  /// error-active now with TEC = REC = 0. False when it is not bus-off or unknown.
+  /// error-active now with TEC = REC = 0 (error-passive with TEC 128 while
+  /// FaultStage::HoldErrorPassive holds it). Ends a FaultStage::ForceBusOff hold. False when it is
+  /// not bus-off or unknown.
   bool RecoverBusOff(PortId port);
 
   /// The fault stage of a bus. Throws std::invalid_argument on an unknown bus.

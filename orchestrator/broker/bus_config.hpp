@@ -20,7 +20,8 @@ struct BusConfig {
   std::size_t tx_queue_capacity = 1024;
   /// Bus-off ports recover by themselves after 128 × 11 recessive bits (ISO 11898-1:2015
   /// §12.1.4.2). When false, only Broker::RecoverBusOff brings them back (like a Linux CAN
-  /// interface with restart-ms 0).
+  /// interface with restart-ms 0). FaultStage::ForceBusOff(port, hold = true) holds one port
+  /// bus-off until RecoverBusOff on a bus that recovers by itself.
   bool auto_recover = true;
   /// Sliding window of the load, frames/s and per-identifier figures.
   Duration stats_window = std::chrono::seconds(1);

@@ -1,5 +1,7 @@
 #include "orchestrator/broker/fault_stage.hpp"
 
+#include "orchestrator/broker/virtual_bus.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -39,9 +41,24 @@ const char* ToString(FaultAction action) {
   return "?";
 }
 
-FaultStage::FaultStage(Scheduler& scheduler, std::function<bool(PortId)> force_bus_off)
-    : scheduler_(scheduler), force_bus_off_(std::move(force_bus_off)) {
+FaultStage::FaultStage(Scheduler& scheduler, detail::VirtualBus& bus) : scheduler_(scheduler), bus_(bus) {
   fired_.reserve(16);
+}
+
+bool FaultStage::ForceBusOff(PortId port, bool hold) {
+  return bus_.ForceBusOff(bus_.PortOnBus(port), hold);
+}
+
+bool FaultStage::HoldErrorPassive(PortId port, bool on) {
+  return bus_.HoldErrorPassive(bus_.PortOnBus(port), on);
+}
+
+bool FaultStage::StartBabbling(PortId port, const CanFrame& frame) {
+  return bus_.StartBabbling(bus_.PortOnBus(port), frame);
+}
+
+bool FaultStage::StopBabbling(PortId port) {
+  return bus_.StopBabbling(bus_.PortOnBus(port));
 }
 
 RuleId FaultStage::Add(FaultRule rule) {

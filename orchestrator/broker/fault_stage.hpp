@@ -6,7 +6,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <functional>
 #include <optional>
 #include <vector>
 
@@ -86,10 +85,9 @@ struct RuleStatus {
 /// reach back to transfers that started before it was added.
 class FaultStage {
  public:
-  /// `force_bus_off` performs a direct controller fault on a port of this bus (the broker passes
-  /// its own). It returns false when the port is already bus-off and throws std::invalid_argument
-  /// when the port is not on this bus.
-  FaultStage(Scheduler& scheduler, std::function<bool(PortId)> force_bus_off);
+  /// `bus` performs the direct controller faults (ForceBusOff, HoldErrorPassive, StartBabbling) on its
+  /// ports; the bus owns its stage.
+  FaultStage(Scheduler& scheduler, detail::VirtualBus& bus);
 
   /// Adds a rule; returns its id (never reused on this bus). Throws std::invalid_argument when the
   /// probability is not within 0..1, a duration is negative, the lifetime is not positive or the
@@ -102,9 +100,40 @@ class FaultStage {
   /// The live rules (expired ones are not listed), in evaluation order.
   std::vector<RuleStatus> List() const;
 
-  /// Direct controller fault: the port goes bus-off now (TEC 256), its TX queue is dropped, and
-  /// it recovers like after any bus-off. Returns false when it already was bus-off.
-  bool ForceBusOff(PortId port) { return force_bus_off_(port); }
+  // ---- Direct controller faults ------------------------------------------------------------
+  // Each applies now, before any transfer that would start at this same instant (the bus first
+  // catches up to now). Each throws std::invalid_argument when the port is not on this bus.
+
+  /// The port goes bus-off now (TEC 256) and its TX queue is dropped. Without `hold` it recovers
+  /// like after any bus-off (after 1408 bit times when the bus auto-recovers, else on
+  /// Broker::RecoverBusOff). With `hold` it stays bus-off until Broker::RecoverBusOff, whatever the
+  /// bus's auto_recover says; the hold ends with that recovery. Returns false when there was
+  /// nothing to do: already bus-off, and (with `hold`) already held. Holding a port that is
+  /// already bus-off cancels its pending automatic recovery.
+  bool ForceBusOff(PortId port, bool hold = false);
+
+  /// Holds the port's controller error-passive (`on`) or releases it; see
+  /// FaultConfinement::HoldErrorPassive for the counters: on = TEC ≥ 128 from now on, the port is
+  /// told it is error-passive at once; successes never bring it back, errors still take it
+  /// bus-off. Off = TEC set to min(TEC, 127), the port is told it is error-active again (unless
+  /// its REC ≥ 128 or it is bus-off). Returns false when the hold already was in that state.
+  bool HoldErrorPassive(PortId port, bool on);
+
+  /// The "babbling idiot": from now on the port's controller offers `frame` in every arbitration,
+  /// ahead of the port's own TX queue (its TX buffer is stuck with that frame), so it floods the
+  /// bus at the full rate the bus allows, taking every arbitration it can win. Others see normal
+  /// frames; error confinement and fault rules apply as for any of its frames; the port's sink
+  /// gets no TX confirmation for them (the node did not send them) and PortStats::babble_frames
+  /// counts them. The port's own frames wait in its queue (and overflow into queue_drops) until
+  /// StopBabbling. Calling it again replaces the frame. It survives bus-off (a bus-off controller
+  /// sends nothing; after recovery it babbles again).
+  ///
+  /// Paced buses only: an unpaced bus has no time line, so "full rate" would mean an endless
+  /// stream in zero time. Throws std::invalid_argument on an unpaced bus or an invalid or error
+  /// frame. Returns false for a listen-only port (it never transmits).
+  bool StartBabbling(PortId port, const CanFrame& frame);
+  /// Ends StartBabbling; a babble frame already on the wire completes. False when not babbling.
+  bool StopBabbling(PortId port);
 
  private:
   friend class detail::VirtualBus;
@@ -143,7 +172,7 @@ class FaultStage {
   void Sweep(BusTime now);
 
   Scheduler& scheduler_;
-  std::function<bool(PortId)> force_bus_off_;
+  detail::VirtualBus& bus_;
   std::vector<Rule> rules_;
   std::vector<std::size_t> fired_;  ///< indexes into rules_ of drop/delay rules fired on this transfer
   RuleId next_id_ = 1;

@@ -60,6 +60,8 @@ struct PortStats {
   std::uint64_t invalid_drops = 0;  ///< invalid frames, error frames, or sent by a listen-only port
   std::uint64_t bus_off_drops = 0;  ///< submitted while bus-off, or flushed from the queue at bus-off
   std::uint64_t fault_drops = 0;    ///< deliveries to this port suppressed by drop rules
+  /// Frames sent by FaultStage::StartBabbling (not in tx_frames: the node did not send them).
+  std::uint64_t babble_frames = 0;
 };
 
 }  // namespace canfleet::broker

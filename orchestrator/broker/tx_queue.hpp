@@ -16,6 +16,7 @@ struct QueuedFrame {
   BusTime submitted{};      ///< broker time of Submit: the frame may join arbitrations from then on
   std::uint64_t seq = 0;    ///< bus-wide submission order (ties in arbitration, unpaced FIFO)
   bool repetition = false;  ///< a repeated transfer scheduled by a duplicate rule
+  bool babble = false;      ///< a babbling idiot's frame (Port::babble), not from the queue
 };
 
 class TxQueue {

@@ -67,14 +67,7 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
     : scheduler_(scheduler),
       config_(Validated(std::move(config))),
       created_(Now()),
-      faults_(
-          scheduler,
-          [this](PortId id) {
-            Port* port = Find(id);
-            if (port == nullptr)
-              throw std::invalid_argument("port " + std::to_string(id) + " is not on bus " + config_.name);
-            return ForceBusOff(*port);
-          }),
+      faults_(scheduler, *this),
       timer_(scheduler, [this] { OnTimer(); }),
       free_at_(created_),
       log_(LogCapacity(config_)) {
@@ -128,11 +121,12 @@ std::size_t VirtualBus::Submit(Port& port, std::span<const CanFrame> frames) {
       ++port.bus_off_drops;
       continue;
     }
-    if (!port.queue.push_back({Normalized(frame), now, next_seq_, false})) {
+    if (!port.queue.push_back({Normalized(frame), now, next_seq_, false, false})) {
       ++port.queue_drops;
       ++queue_drops_;
       continue;
     }
+    if (!config_.paced) order_.push_back({&port, next_seq_});
     ++next_seq_;
     ++accepted;
   }
@@ -156,15 +150,62 @@ bool VirtualBus::RecoverBusOff(Port& port) {
   });
 }
 
-bool VirtualBus::ForceBusOff(Port& port) {
+bool VirtualBus::ForceBusOff(Port& port, bool hold) {
   return WithRound([&] {
     if (port.detached) return false;
-    auto event = port.controller.ForceBusOff();
-    if (!event) return false;
-    Emit(port, event);
+    if (port.controller.State() == ControllerState::kBusOff) {
+      if (!hold || port.hold_bus_off) return false;
+      // Already bus-off: the hold cancels the pending automatic recovery.
+      port.hold_bus_off = true;
+      if (port.recover_at) {
+        port.recover_at.reset();
+        --pending_recoveries_;
+      }
+      return true;
+    }
+    port.hold_bus_off = hold;
+    Emit(port, port.controller.ForceBusOff());
     EnterBusOff(port, Now());
     return true;
   });
+}
+
+bool VirtualBus::HoldErrorPassive(Port& port, bool on) {
+  return WithRound([&] {
+    if (port.detached || port.controller.ErrorPassiveHeld() == on) return false;
+    Emit(port, port.controller.HoldErrorPassive(on));
+    return true;
+  });
+}
+
+bool VirtualBus::StartBabbling(Port& port, const CanFrame& frame) {
+  if (!config_.paced)
+    throw std::invalid_argument("bus " + config_.name +
+                                " is unpaced: a babbling idiot needs the time line of a paced bus");
+  if (!frame.valid() || frame.error())
+    throw std::invalid_argument("babbling idiot: invalid frame " + ToCandump(frame));
+  return WithRound([&] {
+    if (port.detached || port.options.listen_only) return false;
+    // Offered from now on, with a place in the submission order for ties in arbitration.
+    port.babble = {Normalized(frame), Now(), next_seq_++, false, true};
+    port.babbling = true;
+    return true;
+  });
+}
+
+bool VirtualBus::StopBabbling(Port& port) {
+  return WithRound([&] {
+    if (port.detached || !port.babbling) return false;
+    port.babbling = false;
+    return true;
+  });
+}
+
+Port& VirtualBus::PortOnBus(PortId id) const {
+  Port* port = Find(id);
+  if (port == nullptr)
+    throw std::invalid_argument("port " + std::to_string(id) + " is not on bus " + config_.name);
+  return *port;
 }
 
 Port* VirtualBus::Find(PortId id) const {
@@ -201,15 +242,32 @@ void VirtualBus::Run() {
 }
 
 bool VirtualBus::Eligible(const Port& port) const {
-  return !port.detached && !port.queue.empty() && port.controller.State() != ControllerState::kBusOff &&
-         (config_.paced || !port.ack_blocked);
+  return !port.detached && (!port.queue.empty() || port.babbling) &&
+         port.controller.State() != ControllerState::kBusOff && (config_.paced || !port.ack_blocked);
 }
 
 Port* VirtualBus::OldestHead() const {
+  while (!order_.empty()) {
+    const SubmissionOrder::Entry entry = order_.front();
+    const Port& port = *entry.port;
+    // Stale: that frame left its queue (sent, or dropped at bus-off or detach).
+    if (port.detached || port.queue.empty() || port.queue.front().seq != entry.seq) {
+      order_.pop_front();
+      continue;
+    }
+    if (Eligible(port)) return entry.port;
+    // The oldest head waits for an acknowledger (a lone port after an ACK error); then nobody
+    // else can send either, but a scan says so without relying on that.
+    return ScanOldestHead();
+  }
+  return nullptr;
+}
+
+Port* VirtualBus::ScanOldestHead() const {
   Port* oldest = nullptr;
   for (const auto& p : ports_) {
     if (!Eligible(*p)) continue;
-    if (oldest == nullptr || p->queue.front().seq < oldest->queue.front().seq) oldest = p.get();
+    if (oldest == nullptr || Head(*p).seq < Head(*oldest).seq) oldest = p.get();
   }
   return oldest;
 }
@@ -218,7 +276,7 @@ std::optional<BusTime> VirtualBus::NextStart() const {
   if (!config_.paced) {
     const Port* oldest = OldestHead();
     if (oldest == nullptr) return std::nullopt;
-    return oldest->queue.front().submitted;
+    return Head(*oldest).submitted;
   }
   // A frame joins the first arbitration that starts at or after both its submission and the end
   // of its port's suspend-transmission time; the bus starts one as soon as it is idle and some
@@ -227,7 +285,7 @@ std::optional<BusTime> VirtualBus::NextStart() const {
   std::optional<BusTime> earliest;
   for (const auto& p : ports_) {
     if (!Eligible(*p)) continue;
-    const BusTime ready = std::max(p->queue.front().submitted, p->ready_at);
+    const BusTime ready = std::max(Head(*p).submitted, p->ready_at);
     if (!earliest || ready < *earliest) earliest = ready;
   }
   if (!earliest) return std::nullopt;
@@ -243,7 +301,7 @@ Port* VirtualBus::Arbitrate(BusTime start) const {
   std::uint64_t best_seq = 0;
   for (const auto& p : ports_) {
     if (!Eligible(*p)) continue;
-    const QueuedFrame& head = p->queue.front();
+    const QueuedFrame& head = Head(*p);
     if (std::max(head.submitted, p->ready_at) > start) continue;
     const std::uint32_t key = ArbitrationKey(head.frame);
     if (winner == nullptr || key < best_key || (key == best_key && head.seq < best_seq)) {
@@ -295,8 +353,13 @@ void VirtualBus::Process(BusTime now, bool start_at_now) {
     }
     if (!delayed_.empty()) consider(delayed_.front().due, Kind::kDelayed);
     std::optional<BusTime> start;
+    Port* oldest = nullptr;  // unpaced: the next sender, found once per frame
     if (!in_flight_) {
-      start = NextStart();
+      if (config_.paced) {
+        start = NextStart();
+      } else if ((oldest = OldestHead()) != nullptr) {
+        start = Head(*oldest).submitted;
+      }
       if (start) consider(*start, Kind::kStart);
     }
     if (kind == Kind::kNone || at > now) return;
@@ -322,14 +385,14 @@ void VirtualBus::Process(BusTime now, bool start_at_now) {
       case Kind::kStart: {
         if (config_.paced) {
           Port* winner = Arbitrate(*start);
-          const QueuedFrame& head = winner->queue.front();
+          const QueuedFrame& head = Head(*winner);
           const TransferOutcome outcome = Outcome(*winner, head.frame, *start);
           const BusTime end = *start + BitTime(AttemptBits(head.frame, outcome), config_.bitrate);
           in_flight_ = InFlight{winner, head, winner->queue_epoch, *start, end, outcome};
         } else {
           // No time line: the oldest submission goes, taking no time.
-          Port* winner = OldestHead();
-          const QueuedFrame head = winner->queue.front();
+          Port* winner = oldest;
+          const QueuedFrame head = Head(*winner);
           const TransferOutcome outcome = Outcome(*winner, head.frame, head.submitted);
           // A lone unpaced port would retry forever in zero time: it waits for another port.
           if (outcome == TransferOutcome::kAckError) winner->ack_blocked = true;
@@ -383,11 +446,19 @@ void VirtualBus::Complete(const InFlight& transfer) {
           ++fault_delays_;
           break;
       }
-      // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8).
-      if (!rx.options.listen_only) Emit(rx, rx.controller.OnReceiveSuccess());
+      // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8). Usually nothing to
+      // count (error-active, REC 0): tested first, this is the hot loop of the broker.
+      if (!rx.options.listen_only && !rx.controller.ReceiveSuccessChangesNothing())
+        Emit(rx, rx.controller.OnReceiveSuccess());
     }
     if (faults) faults_.EndOfTransfer(transfer.start);
-    if (tx_live) {
+    if (tx_live && transfer.entry.babble) {
+      // Not the node's frame: no confirmation, nothing leaves its queue.
+      ++tx.babble_frames;
+      tx.babble.repetition = repeat;
+      Emit(tx, tx.controller.OnTransmitSuccess());
+      SuspendIfPassive(tx, transfer.end);
+    } else if (tx_live) {
       ++tx.tx_frames;
       if (!transfer.entry.repetition) tx.tx.push_back(timed);
       if (repeat)
@@ -445,7 +516,12 @@ void VirtualBus::Recover(Port& port) {
     port.recover_at.reset();
     --pending_recoveries_;
   }
+  port.hold_bus_off = false;
   Emit(port, port.controller.Recover());
+  // The recovered controller acknowledges again: unpaced ports waiting after an ACK error may
+  // try again (as when a port attaches).
+  for (auto& p : ports_)
+    p->ack_blocked = false;
 }
 
 void VirtualBus::EnterBusOff(Port& port, BusTime at) {
@@ -456,7 +532,7 @@ void VirtualBus::EnterBusOff(Port& port, BusTime at) {
   port.ready_at = BusTime{};
   // Recovery after 128 occurrences of 11 consecutive recessive bits (ISO 11898-1:2015 §12.1.4.2),
   // counted as 1408 bit times from the end of the error frame that caused the bus-off.
-  if (config_.auto_recover && !port.recover_at) {
+  if (config_.auto_recover && !port.hold_bus_off && !port.recover_at) {
     port.recover_at = at + BitTime(kBusOffRecoveryBits, config_.bitrate);
     ++pending_recoveries_;
   }
@@ -527,13 +603,11 @@ void VirtualBus::FlushPort(Port& port) {
   std::size_t tx_done = 0;
   auto frames_up_to = [&](std::size_t rx_mark, std::size_t tx_mark) {
     if (rx_mark > rx_done) {
-      if (port.sink != nullptr)
-        port.sink->Deliver(std::span<const TimedFrame>(port.rx).subspan(rx_done, rx_mark - rx_done));
+      if (port.sink != nullptr) port.sink->Deliver(port.rx.frames().subspan(rx_done, rx_mark - rx_done));
       rx_done = rx_mark;
     }
     if (tx_mark > tx_done) {
-      if (port.sink != nullptr)
-        port.sink->TxConfirmed(std::span<const TimedFrame>(port.tx).subspan(tx_done, tx_mark - tx_done));
+      if (port.sink != nullptr) port.sink->TxConfirmed(port.tx.frames().subspan(tx_done, tx_mark - tx_done));
       tx_done = tx_mark;
     }
   };
@@ -551,6 +625,9 @@ void VirtualBus::FlushPort(Port& port) {
 void VirtualBus::Sweep() {
   if (!sweep_needed_) return;
   const Port* on_wire = in_flight_ ? in_flight_->port : nullptr;
+  // No entry may outlive its port (a detached port's entries are stale anyway).
+  order_.EraseIf(
+      [on_wire](const SubmissionOrder::Entry& e) { return e.port->detached && e.port != on_wire; });
   std::erase_if(ports_,
                 [on_wire](const std::unique_ptr<Port>& p) { return p->detached && p.get() != on_wire; });
   sweep_needed_ = on_wire != nullptr && on_wire->detached;
@@ -594,6 +671,7 @@ PortStats VirtualBus::StatsOf(const Port& port) const {
   s.invalid_drops = port.invalid_drops;
   s.bus_off_drops = port.bus_off_drops;
   s.fault_drops = port.fault_drops;
+  s.babble_frames = port.babble_frames;
   return s;
 }
 

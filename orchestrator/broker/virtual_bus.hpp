@@ -21,8 +21,10 @@
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/bus_config.hpp"
 #include "orchestrator/broker/fault_stage.hpp"
+#include "orchestrator/broker/outbox.hpp"
 #include "orchestrator/broker/port_sink.hpp"
 #include "orchestrator/broker/stats.hpp"
+#include "orchestrator/broker/submission_order.hpp"
 #include "orchestrator/broker/transmission_log.hpp"
 #include "orchestrator/broker/tx_queue.hpp"
 #include "orchestrator/broker/wire_model.hpp"
@@ -51,7 +53,11 @@ struct Port {
   FaultConfinement controller;
   BusTime ready_at{};                 ///< suspend transmission: may not start a transfer before
   std::optional<BusTime> recover_at;  ///< automatic bus-off recovery due
+  bool hold_bus_off = false;          ///< bus-off until RecoverBusOff (FaultStage::ForceBusOff hold)
   bool ack_blocked = false;           ///< unpaced: head got an ACK error, wait for another port
+  /// Babbling idiot (FaultStage::StartBabbling): this entry is offered ahead of the queue.
+  bool babbling = false;
+  QueuedFrame babble{};
 
   // Outbox of the current round: frames, confirmations and controller events, in bus order.
   struct PendingEvent {
@@ -59,13 +65,14 @@ struct Port {
     std::size_t tx_mark;
     ControllerEvent event;
   };
-  std::vector<TimedFrame> rx;
-  std::vector<TimedFrame> tx;
+  Outbox rx;
+  Outbox tx;
   std::vector<PendingEvent> events;
   bool HasOutbox() const { return !rx.empty() || !tx.empty() || !events.empty(); }
 
   std::uint64_t tx_frames = 0, rx_frames = 0, tx_errors = 0, rx_errors = 0;
   std::uint64_t queue_drops = 0, invalid_drops = 0, bus_off_drops = 0, fault_drops = 0;
+  std::uint64_t babble_frames = 0;
 };
 
 class VirtualBus {
@@ -81,7 +88,13 @@ class VirtualBus {
   void Detach(Port& port);
   std::size_t Submit(Port& port, std::span<const CanFrame> frames);
   bool RecoverBusOff(Port& port);
-  bool ForceBusOff(Port& port);
+  // Direct controller faults (FaultStage's public face documents them).
+  bool ForceBusOff(Port& port, bool hold);
+  bool HoldErrorPassive(Port& port, bool on);
+  bool StartBabbling(Port& port, const CanFrame& frame);
+  bool StopBabbling(Port& port);
+  /// The attached port `id`; throws std::invalid_argument when it is not on this bus.
+  Port& PortOnBus(PortId id) const;
 
   FaultStage& Faults() { return faults_; }
   BusStats Stats(std::size_t top_ids) const;
@@ -123,9 +136,17 @@ class VirtualBus {
   /// start at `now` itself (false while catching up before a control action).
   void Process(BusTime now, bool start_at_now);
   bool Eligible(const Port& port) const;
+  /// What the port offers for arbitration: its babble frame while babbling, else its queue's head.
+  /// Only for an eligible port.
+  static const QueuedFrame& Head(const Port& port) {
+    return port.babbling ? port.babble : port.queue.front();
+  }
   std::optional<BusTime> NextStart() const;
   Port* Arbitrate(BusTime start) const;
+  /// Unpaced: the eligible port whose head was submitted first (O(1), see SubmissionOrder).
   Port* OldestHead() const;
+  /// The same by a scan of the ports: when the oldest head's port is waiting for an acknowledger.
+  Port* ScanOldestHead() const;
   /// Whether `port` was on the bus when a transfer started at `start` (a port that attaches
   /// mid-frame missed its start of frame). Unpaced buses have no time line: every attached port.
   bool AttachedBy(const Port& port, BusTime start) const {
@@ -153,6 +174,9 @@ class VirtualBus {
   Timer timer_;
 
   std::vector<std::unique_ptr<Port>> ports_;
+  /// Unpaced buses: every accepted frame in submission order. Mutable: OldestHead discards stale
+  /// entries as it finds them, which changes no observable state.
+  mutable SubmissionOrder order_;
   std::optional<InFlight> in_flight_;
   BusTime free_at_{};  ///< end of the last transfer (intermission included): the bus is idle from then
   std::vector<Delayed> delayed_;  ///< min-heap on (due, seq)

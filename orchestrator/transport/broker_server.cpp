@@ -5,6 +5,7 @@
 
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/ip/address.hpp>
+#include <asio/post.hpp>
 #include <asio/steady_timer.hpp>
 #include <stdexcept>
 
@@ -117,10 +118,27 @@ void BrokerServer::OnAccept(const asio::error_code& ec, std::string peer,
   }
   stats_->accepted++;
   const std::string label = "session " + std::to_string(next_session_++) + " (" + peer + ")";
-  auto session = std::make_shared<detail::Session>(broker_, options_, stats_, std::move(socket), label,
-                                                   [this](detail::Session* s) { Remove(s); });
+  auto session = std::make_shared<detail::Session>(
+      broker_, options_, stats_, std::move(socket), label, [this](detail::Session* s) { Remove(s); },
+      &next_attach_);
   sessions_.emplace(session.get(), session);
   session->Start();
+}
+
+void BrokerServer::RequestNode(std::string_view bus, std::string_view node_name, wire::NodeRequest request,
+                               NodeReplyHandler done) {
+  stats_->node_requests++;
+  detail::Session* target = nullptr;
+  for (const auto& [ptr, session] : sessions_) {
+    if (!session->Attached() || session->Bus() != bus || session->NodeName() != node_name) continue;
+    if (target == nullptr || session->AttachOrder() > target->AttachOrder()) target = ptr;
+  }
+  if (target == nullptr) {
+    spdlog::debug("node request: no node {} on bus {}", node_name, bus);
+    asio::post(io_, [done = std::move(done)] { done(std::nullopt); });
+    return;
+  }
+  target->Request(std::move(request), std::move(done));
 }
 
 void BrokerServer::Remove(detail::Session* session) {

@@ -8,12 +8,16 @@
 #include <asio/local/stream_protocol.hpp>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
 #include "bus/wire/endpoint.hpp"
+#include "bus/wire/messages.hpp"
 #include "orchestrator/broker/broker.hpp"
 
 namespace canfleet::transport {
@@ -31,6 +35,8 @@ struct ServerOptions {
   /// After a protocol error, how long the Error message may take to leave before the socket is
   /// closed anyway.
   std::chrono::milliseconds close_linger{1'000};
+  /// RequestNode gives up (nullopt) when the node has not answered by then.
+  std::chrono::milliseconds node_request_timeout{3'000};
 };
 
 struct ServerStats {
@@ -39,7 +45,14 @@ struct ServerStats {
   std::uint64_t refused = 0;          ///< Hellos refused (version, unknown bus, bad names)
   std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or out-of-order data
   std::uint64_t backlog_drops = 0;    ///< frames not sent to slow readers
+  std::uint64_t node_requests = 0;    ///< RequestNode calls
+  std::uint64_t node_replies = 0;     ///< of those, answered by the node (error or not)
 };
+
+/// Called once per RequestNode: the node's reply, or nullopt when no node of that name is
+/// attached to that bus, it disconnected first, or it did not answer within
+/// ServerOptions::node_request_timeout.
+using NodeReplyHandler = std::function<void(std::optional<wire::NodeReply>)>;
 
 /// Accepts connections and runs one session per connection: a valid Hello attaches a port to the
 /// named bus (Broker::Attach), frames it sends are submitted, and what the broker delivers to the
@@ -65,7 +78,18 @@ class BrokerServer {
   wire::Endpoint Listen(const wire::Endpoint& endpoint);
 
   /// Stops accepting and closes every session. Unix socket files created by Listen are removed.
+  /// Pending RequestNode calls get their nullopt before this returns.
   void Close();
+
+  /// Sends `request` to the node attached to `bus` under `node_name` (Hello.node_name; the most
+  /// recent attachment if several carry that name) and calls `done` with its reply, whose
+  /// request_id is the one of `request` (the server numbers what it sends itself, so callers need
+  /// not make ids unique). `done` is called exactly once, on the io thread, never from inside
+  /// this call: with nullopt when the node is unknown, disconnects before answering, the server
+  /// closes, or the timeout passes. A reply with a non-empty `error` is the node's refusal
+  /// ("unknown signal ...").
+  void RequestNode(std::string_view bus, std::string_view node_name, wire::NodeRequest request,
+                   NodeReplyHandler done);
 
   std::size_t SessionCount() const { return sessions_.size(); }
   const std::vector<wire::Endpoint>& Endpoints() const { return endpoints_; }
@@ -89,6 +113,7 @@ class BrokerServer {
   std::vector<wire::Endpoint> endpoints_;
   std::unordered_map<detail::Session*, std::shared_ptr<detail::Session>> sessions_;
   std::uint64_t next_session_ = 1;
+  std::uint64_t next_attach_ = 1;  ///< attach order of sessions (RequestNode picks the latest)
   bool closed_ = false;
 };
 

@@ -31,14 +31,16 @@ std::string JoinBuses(const std::vector<std::string>& names) {
 }  // namespace
 
 Session::Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
-                 asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed)
+                 asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed,
+                 std::uint64_t* attach_counter)
     : broker_(broker),
       options_(options),
       stats_(std::move(stats)),
       socket_(std::move(socket)),
       timer_(socket_.get_executor()),
       label_(std::move(label)),
-      on_closed_(std::move(on_closed)) {}
+      on_closed_(std::move(on_closed)),
+      attach_counter_(attach_counter) {}
 
 Session::~Session() {
   // Close() detaches before the last reference goes; this only guards a session that never ran.
@@ -113,11 +115,66 @@ void Session::Handle(const wire::Message& m) {
       Close("peer closed the connection: " + m.envelope.error().reason(), Farewell::kNone,
             spdlog::level::info);
       return;
+    case MessageType::kNodeReply:
+      OnNodeReply(m.envelope.node_reply());
+      return;
     case MessageType::kHelloReply:
     case MessageType::kTxConfirm:
     case MessageType::kControllerEvent:
+    case MessageType::kNodeRequest:
       ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from a node");
       return;
+  }
+}
+
+void Session::Request(wire::NodeRequest request, NodeReplyHandler done) {
+  if (!Attached()) {
+    asio::post(socket_.get_executor(), [done = std::move(done)] { done(std::nullopt); });
+    return;
+  }
+  const std::uint64_t id = next_request_++;
+  PendingRequest& pending = pending_[id];
+  pending.caller_id = request.request_id();
+  pending.done = std::move(done);
+  pending.deadline =
+      std::make_unique<asio::steady_timer>(socket_.get_executor(), options_.node_request_timeout);
+  pending.deadline->async_wait([this, self = shared_from_this(), id](const asio::error_code& ec) {
+    if (ec) return;
+    auto it = pending_.find(id);
+    if (it == pending_.end()) return;
+    NodeReplyHandler handler = std::move(it->second.done);
+    pending_.erase(it);
+    spdlog::warn("{}: no reply to node request {} within {} ms", label_, id,
+                 options_.node_request_timeout.count());
+    handler(std::nullopt);
+  });
+  request.set_request_id(id);
+  filling_.AddNodeRequest(request);
+  ScheduleFlush();
+}
+
+void Session::OnNodeReply(const wire::NodeReply& reply) {
+  auto it = pending_.find(reply.request_id());
+  if (it == pending_.end()) {
+    // Answered after its deadline (the caller was already told): nothing to do.
+    spdlog::debug("{}: reply to node request {} that is no longer pending", label_, reply.request_id());
+    return;
+  }
+  PendingRequest pending = std::move(it->second);
+  pending_.erase(it);
+  pending.deadline->cancel();
+  stats_->node_replies++;
+  wire::NodeReply answer = reply;
+  answer.set_request_id(pending.caller_id);
+  pending.done(std::move(answer));
+}
+
+void Session::FailPendingRequests() {
+  auto pending = std::move(pending_);
+  pending_.clear();
+  for (auto& [id, request] : pending) {
+    request.deadline->cancel();
+    request.done(std::nullopt);
   }
 }
 
@@ -153,6 +210,9 @@ void Session::OnHello(const wire::Hello& hello) {
   std::string name = hello.node_name().empty() ? label_ : hello.node_name();
   try {
     port_ = broker_.Attach(hello.bus(), name, *this, attach);
+    bus_ = hello.bus();
+    node_name_ = hello.node_name();
+    attach_order_ = (*attach_counter_)++;
   } catch (const std::invalid_argument&) {
     Refuse("unknown bus " + hello.bus() + " (this broker has: " + JoinBuses(broker_.Buses()) + ")");
     return;
@@ -201,6 +261,7 @@ void Session::Close(const std::string& reason, Farewell farewell, spdlog::level:
   }
   timer_.cancel();
   if (on_closed_) on_closed_(this);
+  FailPendingRequests();
   if (farewell == Farewell::kNone || !socket_.is_open()) {
     CloseSocket();
     return;

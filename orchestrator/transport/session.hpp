@@ -6,9 +6,12 @@
 
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/steady_timer.hpp>
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "bus/wire/message_writer.hpp"
@@ -29,8 +32,11 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
  public:
   using ClosedHandler = std::function<void(Session*)>;
 
+  /// `attach_counter`: the server's counter of accepted Hellos (AttachOrder); outlives the
+  /// session's Hello.
   Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
-          asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed);
+          asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed,
+          std::uint64_t* attach_counter);
   ~Session() override;
 
   void Start();
@@ -45,6 +51,16 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   /// ServerOptions::close_linger at most). `level` is the log level of the reason.
   void Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level);
 
+  /// Attached to a bus and not closed.
+  bool Attached() const { return port_ != 0 && !closed_; }
+  const std::string& Bus() const { return bus_; }
+  const std::string& NodeName() const { return node_name_; }
+  /// Order of the accepted Hello among the server's sessions (later = larger).
+  std::uint64_t AttachOrder() const { return attach_order_; }
+
+  /// Sends a NodeRequest (BrokerServer::RequestNode documents `done`).
+  void Request(wire::NodeRequest request, NodeReplyHandler done);
+
   // broker::PortSink
   void Deliver(std::span<const broker::TimedFrame> frames) override;
   void ControllerChanged(const ControllerEvent& event) override;
@@ -54,6 +70,9 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   void Read();
   void Handle(const wire::Message& message);
   void OnHello(const wire::Hello& hello);
+  void OnNodeReply(const wire::NodeReply& reply);
+  /// Closing: every pending request ends with nullopt.
+  void FailPendingRequests();
   void Refuse(const std::string& reason);
   void ProtocolError(const std::string& reason);
   void ScheduleFlush();
@@ -69,6 +88,10 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   ClosedHandler on_closed_;
 
   broker::PortId port_ = 0;  ///< 0 until a Hello is accepted
+  std::string bus_;          ///< from the accepted Hello
+  std::string node_name_;    ///< from the accepted Hello ("" when it gave none)
+  std::uint64_t* attach_counter_;
+  std::uint64_t attach_order_ = 0;
   bool tx_confirmations_ = false;
   bool closed_ = false;
 
@@ -81,6 +104,15 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   bool write_in_flight_ = false;
   bool flush_posted_ = false;
   std::uint64_t backlog_drops_ = 0;  ///< frames dropped in the current backlog episode
+
+  /// NodeRequests waiting for their reply, by the id this session gave them.
+  struct PendingRequest {
+    std::uint64_t caller_id = 0;  ///< the caller's request_id, restored in the reply
+    NodeReplyHandler done;
+    std::unique_ptr<asio::steady_timer> deadline;
+  };
+  std::unordered_map<std::uint64_t, PendingRequest> pending_;
+  std::uint64_t next_request_ = 1;
 };
 
 }  // namespace canfleet::transport::detail

@@ -247,7 +247,7 @@ TEST(BrokerProtocolErrors, BadConnectionsAreClosedWithAReasonWhileOthersCarryOn)
   struct Case {
     const char* what;
     std::string bytes;
-    const char* reason;  // in the reply and in the broker's log
+    std::string reason;  // in the reply and in the broker's log
     bool refusal;        // HelloReply{accepted: false} rather than Error
   };
   const std::vector<Case> cases = {
@@ -266,7 +266,9 @@ TEST(BrokerProtocolErrors, BadConnectionsAreClosedWithAReasonWhileOthersCarryOn)
        }),
        "protocol error: second Hello", false},
       {"protocol version 99", Encoded([&](wire::MessageWriter& w) { w.AddHello(old_version); }),
-       "protocol version 99 not supported: this broker speaks version 1", true},
+       "protocol version 99 not supported: this broker speaks version " +
+           std::to_string(wire::kProtocolVersion),
+       true},
       {"an unknown bus", Encoded([](wire::MessageWriter& w) { w.AddHello(wire::MakeHello("can7", "lost")); }),
        "unknown bus can7 (this broker has: can0, can1)", true},
   };

@@ -5,9 +5,11 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <asio/io_context.hpp>
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -322,6 +324,161 @@ TEST_F(Transport, BrokerAnswersPing) {
   EXPECT_EQ(replies[1].type, wire::MessageType::kHelloReply);
   EXPECT_TRUE(replies[1].envelope.hello_reply().accepted());
   EXPECT_EQ(replies[2].envelope.pong().nonce(), 8u);
+}
+
+// ---- NodeRequest / NodeReply (remote I/O) -------------------------------------------------------
+
+wire::NodeRequest IoGetRequest(std::uint64_t id, const std::string& name) {
+  wire::NodeRequest r;
+  r.set_request_id(id);
+  r.mutable_io_get()->set_name(name);
+  return r;
+}
+
+TEST_F(Transport, ANodeRequestReachesTheNamedNodeAndItsReplyComesBack) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  broker_.AddBus({.name = "can1", .bitrate = 500'000});
+  auto quad = Client(ep, "quad-5");
+  auto other = Client(ep, "quad-5", "can1");  // same name, other bus: not asked
+  auto plain = Client(ep, "plain");           // serves no requests
+  std::vector<std::string> seen;
+  quad->OnNodeRequest([&](const wire::NodeRequest& r) {
+    seen.push_back(r.ShortDebugString());
+    wire::NodeReply reply;
+    auto* v = reply.add_values();
+    v->set_name(r.io_get().name());
+    v->set_value("2500");
+    v->set_unit("mV");
+    v->set_input(true);
+    return reply;
+  });
+  other->OnNodeRequest([&](const wire::NodeRequest&) {
+    ADD_FAILURE() << "the node on can1 was asked";
+    return wire::NodeReply();
+  });
+  ASSERT_TRUE(RunUntil([&] { return quad->Connected() && other->Connected() && plain->Connected(); }));
+
+  std::vector<std::optional<wire::NodeReply>> replies;
+  auto collect = [&](std::optional<wire::NodeReply> r) { replies.push_back(std::move(r)); };
+  server.RequestNode("can0", "quad-5", IoGetRequest(77, "AIN1.voltage_mV"), collect);
+  server.RequestNode("can0", "quad-5", IoGetRequest(77, "AIN2.voltage_mV"),
+                     collect);  // ids need not be unique
+  server.RequestNode("can0", "plain", IoGetRequest(5, ""), collect);
+  server.RequestNode("can0", "nobody", IoGetRequest(6, ""), collect);
+  server.RequestNode("can2", "quad-5", IoGetRequest(7, ""), collect);
+  EXPECT_TRUE(replies.empty());  // never from inside RequestNode
+  ASSERT_TRUE(RunUntil([&] { return replies.size() == 5; }));
+  RunUntil([] { return false; }, 50ms);  // nothing more arrives
+  ASSERT_EQ(replies.size(), 5u);
+
+  // Unknown node and unknown bus: nullopt; the others answered (in any order).
+  std::vector<std::string> answered;
+  for (const auto& r : replies)
+    if (r) answered.push_back(r->ShortDebugString());
+  ASSERT_EQ(answered.size(), 3u);
+  std::sort(answered.begin(), answered.end());
+  EXPECT_EQ(answered,
+            (std::vector<std::string>{
+                R"(request_id: 5 error: "plain serves no node requests")",
+                R"(request_id: 77 values { name: "AIN1.voltage_mV" value: "2500" unit: "mV" input: true })",
+                R"(request_id: 77 values { name: "AIN2.voltage_mV" value: "2500" unit: "mV" input: true })",
+            }));
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_NE(seen[0].find("io_get { name: \"AIN1.voltage_mV\" }"), std::string::npos) << seen[0];
+  EXPECT_EQ(server.Stats().node_requests, 5u);
+  EXPECT_EQ(server.Stats().node_replies, 3u);
+}
+
+/// Attaches a raw connection that says Hello as `name` on can0 and then never reads or answers.
+std::unique_ptr<RawConnection> SilentNode(const std::string& endpoint, const std::string& name) {
+  auto raw = std::make_unique<RawConnection>(endpoint);
+  wire::MessageWriter hello;
+  hello.AddHello(wire::MakeHello("can0", name));
+  EXPECT_TRUE(raw->Send(std::vector<std::uint8_t>(hello.Bytes().begin(), hello.Bytes().end())));
+  return raw;
+}
+
+TEST_F(Transport, ANodeThatDoesNotAnswerTimesOut) {
+  LogCapture log;
+  transport::BrokerServer server(io_, broker_, {.node_request_timeout = 200ms});
+  const std::string ep = Listen(server);
+  auto silent = SilentNode(ep, "mute");
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("can0").size() == 1; }));
+  int calls = 0;
+  std::optional<wire::NodeReply> reply = wire::NodeReply();
+  const auto start = std::chrono::steady_clock::now();
+  server.RequestNode("can0", "mute", IoGetRequest(1, ""), [&](std::optional<wire::NodeReply> r) {
+    ++calls;
+    reply = std::move(r);
+  });
+  ASSERT_TRUE(RunUntil([&] { return calls == 1; }));
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 200ms);
+  EXPECT_FALSE(reply);
+  RunUntil([] { return false; }, 50ms);
+  EXPECT_EQ(calls, 1);
+  EXPECT_NE(log.Text().find("no reply to node request 1 within 200 ms"), std::string::npos) << log.Text();
+}
+
+TEST_F(Transport, ADisconnectEndsPendingRequestsAtOnce) {
+  transport::BrokerServer server(io_, broker_, {.node_request_timeout = 60s});
+  const std::string ep = Listen(server);
+  auto silent = SilentNode(ep, "mute");
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("can0").size() == 1; }));
+  int calls = 0;
+  bool got_reply = true;
+  for (int i = 0; i < 3; ++i)
+    server.RequestNode("can0", "mute", IoGetRequest(1, ""), [&](std::optional<wire::NodeReply> r) {
+      ++calls;
+      got_reply = got_reply && r.has_value();
+    });
+  RunUntil([] { return false; }, 20ms);
+  EXPECT_EQ(calls, 0);
+  silent.reset();
+  ASSERT_TRUE(RunUntil([&] { return calls == 3; }, 5s));  // far below the 60 s timeout
+  EXPECT_FALSE(got_reply);
+}
+
+TEST_F(Transport, ClosingTheServerEndsPendingRequests) {
+  auto server = std::make_unique<transport::BrokerServer>(io_, broker_);
+  const std::string ep = Listen(*server);
+  auto silent = SilentNode(ep, "mute");
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("can0").size() == 1; }));
+  int calls = 0;
+  server->RequestNode("can0", "mute", IoGetRequest(1, ""), [&](std::optional<wire::NodeReply> r) {
+    ++calls;
+    EXPECT_FALSE(r);
+  });
+  RunUntil([] { return false; }, 20ms);
+  server.reset();
+  RunUntil([&] { return calls == 1; });
+  EXPECT_EQ(calls, 1);
+}
+
+TEST_F(Transport, ANodeReplyBeforeHelloOrANodeRequestFromANodeIsAProtocolError) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  std::atomic<int> closed = 0;
+  std::thread peer([&] {
+    {
+      RawConnection raw(ep);
+      wire::MessageWriter w;
+      w.AddNodeReply(wire::NodeReply());
+      raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+      if (raw.ReadUntilClosed().closed) ++closed;
+    }
+    {
+      RawConnection raw(ep);
+      wire::MessageWriter w;
+      w.AddHello(wire::MakeHello("can0", "confused"));
+      w.AddNodeRequest(IoGetRequest(1, ""));
+      raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+      if (raw.ReadUntilClosed().closed) ++closed;
+    }
+  });
+  ASSERT_TRUE(RunUntil([&] { return closed.load() == 2; }));
+  peer.join();
+  EXPECT_EQ(server.Stats().protocol_errors, 2u);
 }
 
 }  // namespace

@@ -91,5 +91,84 @@ TEST(FaultConfinement, ForcedBusOffForFaultInjection) {
   EXPECT_TRUE(c.Recover());
 }
 
+// Fault injection: an error-passive hold. TEC jumps to 128 (event), successes stop at 128, errors
+// still count (rule 3) up to bus-off; a recovery while held ends error-passive at 128.
+TEST(FaultConfinement, AHeldControllerStaysErrorPassive) {
+  FaultConfinement c;
+  c.OnTransmitError(TransmitError::kBit);  // TEC 8
+  auto held = c.HoldErrorPassive(true);
+  ASSERT_TRUE(held);
+  EXPECT_EQ(held->state, ControllerState::kErrorPassive);
+  EXPECT_EQ(held->tec, 128);
+  EXPECT_FALSE(c.HoldErrorPassive(true));
+  for (int i = 0; i < 300; ++i)
+    EXPECT_FALSE(c.OnTransmitSuccess());
+  EXPECT_EQ(c.Tec(), 128);
+  EXPECT_EQ(c.State(), ControllerState::kErrorPassive);
+  EXPECT_FALSE(c.OnTransmitError(TransmitError::kAck));  // rule 3 exception 1 still holds
+  for (int i = 0; i < 15; ++i)
+    EXPECT_FALSE(c.OnTransmitError(TransmitError::kBit));
+  auto bus_off = c.OnTransmitError(TransmitError::kBit);  // 128 + 16 × 8 = 256 > 255
+  ASSERT_TRUE(bus_off);
+  EXPECT_EQ(bus_off->state, ControllerState::kBusOff);
+  auto recovered = c.Recover();
+  ASSERT_TRUE(recovered);
+  EXPECT_EQ(recovered->state, ControllerState::kErrorPassive);
+  EXPECT_EQ(recovered->tec, 128);
+  EXPECT_EQ(recovered->rec, 0);
+}
+
+// Released, TEC is min(TEC, 127): error-active again, counting down from there; REC is untouched,
+// so REC ≥ 128 keeps the controller passive.
+TEST(FaultConfinement, ReleasingTheHoldLeavesTec127) {
+  FaultConfinement c;
+  c.HoldErrorPassive(true);
+  for (int i = 0; i < 5; ++i)
+    c.OnTransmitError(TransmitError::kBit);  // TEC 168
+  auto released = c.HoldErrorPassive(false);
+  ASSERT_TRUE(released);
+  EXPECT_EQ(released->state, ControllerState::kErrorActive);
+  EXPECT_EQ(released->tec, 127);
+  EXPECT_FALSE(c.HoldErrorPassive(false));
+  c.OnTransmitSuccess();
+  EXPECT_EQ(c.Tec(), 126);
+
+  FaultConfinement r;
+  for (int i = 0; i < 130; ++i)
+    r.OnReceiveError();
+  EXPECT_FALSE(r.HoldErrorPassive(true));  // already passive (REC): no event
+  EXPECT_EQ(r.Tec(), 128);
+  EXPECT_FALSE(r.HoldErrorPassive(false));  // still passive through REC 130
+  EXPECT_EQ(r.Tec(), 127);
+  EXPECT_EQ(r.State(), ControllerState::kErrorPassive);
+}
+
+// A hold set while bus-off takes effect at the recovery; released while bus-off, the recovery is
+// the ordinary one.
+TEST(FaultConfinement, AHoldSetWhileBusOffAppliesAtRecovery) {
+  FaultConfinement c;
+  c.ForceBusOff();
+  EXPECT_FALSE(c.HoldErrorPassive(true));
+  EXPECT_EQ(c.State(), ControllerState::kBusOff);
+  EXPECT_EQ(c.Recover()->state, ControllerState::kErrorPassive);
+  c.ForceBusOff();
+  EXPECT_FALSE(c.HoldErrorPassive(false));
+  auto recovered = c.Recover();
+  EXPECT_EQ(recovered->state, ControllerState::kErrorActive);
+  EXPECT_EQ(recovered->tec, 0);
+}
+
+// The broker's hot-loop test: nothing to count for an error-active receiver with REC 0.
+TEST(FaultConfinement, ReceiveSuccessChangesNothingOnlyAtRest) {
+  FaultConfinement c;
+  EXPECT_TRUE(c.ReceiveSuccessChangesNothing());
+  c.OnReceiveError();
+  EXPECT_FALSE(c.ReceiveSuccessChangesNothing());
+  c.OnReceiveSuccess();
+  EXPECT_TRUE(c.ReceiveSuccessChangesNothing());
+  c.ForceBusOff();
+  EXPECT_FALSE(c.ReceiveSuccessChangesNothing());
+}
+
 }  // namespace
 }  // namespace canfleet

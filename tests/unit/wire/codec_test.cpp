@@ -45,13 +45,27 @@ Bytes MixedStream() {
   w.AddFrame(Frame("181#AA"), BusTime(6000));
   w.AddPing(42);
   w.AddPong(43);
+  NodeRequest request;
+  request.set_request_id(7);
+  request.mutable_io_set()->set_name("AIN1.voltage_mV");
+  request.mutable_io_set()->set_value("3000");
+  w.AddNodeRequest(request);
+  NodeReply node_reply;
+  node_reply.set_request_id(7);
+  IoValue& value = *node_reply.add_values();
+  value.set_name("AIN1.voltage_mV");
+  value.set_value("3000");
+  value.set_unit("mV");
+  value.set_input(true);
+  w.AddNodeReply(node_reply);
+  w.AddFrame(Frame("182#BB"), BusTime(7000));
   w.AddError("bye");
   return ToBytes(w.Bytes());
 }
 
 const std::vector<std::string> kMixedExpected = {
-    R"(Hello protocol_version: 1 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true)",
-    "HelloReply accepted: true protocol_version: 1 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
+    R"(Hello protocol_version: 2 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true)",
+    "HelloReply accepted: true protocol_version: 2 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
     "FrameBatch 123#DEADBEEF@1000 7FF#@2000 1FFFFFFF#0102030405060708@3000 701#R1@4000",
     "TxConfirm 185#01@4500",
     "FrameBatch 080#@5000",
@@ -59,6 +73,9 @@ const std::vector<std::string> kMixedExpected = {
     "FrameBatch 181#AA@6000",
     "Ping 42",
     "Pong 43",
+    R"(NodeRequest request_id: 7 io_set { name: "AIN1.voltage_mV" value: "3000" })",
+    R"(NodeReply request_id: 7 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })",
+    "FrameBatch 182#BB@7000",
     "Error bye",
 };
 

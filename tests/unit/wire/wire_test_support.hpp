@@ -53,6 +53,12 @@ inline std::string Describe(const Message& m) {
     case MessageType::kError:
       out += " " + m.envelope.error().reason();
       break;
+    case MessageType::kNodeRequest:
+      out += " " + m.envelope.node_request().ShortDebugString();
+      break;
+    case MessageType::kNodeReply:
+      out += " " + m.envelope.node_reply().ShortDebugString();
+      break;
   }
   return out;
 }
