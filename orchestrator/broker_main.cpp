@@ -1,8 +1,10 @@
 // canfleet-broker: serves virtual CAN buses to node processes over TCP and Unix-domain sockets.
-// main only wires the Broker, its AsioScheduler and the transport (orchestrator/transport/).
+// main only wires the Broker, its AsioScheduler, the transport (orchestrator/transport/) and the
+// telemetry (orchestrator/broker_telemetry/: BusStats of every bus over DDS).
 //
 //   canfleet-broker --bus can0:500k --bus can1:1M:unpaced
 //                   --listen tcp://127.0.0.1:29600 --listen unix:///tmp/canfleet.sock
+//                   [--dds-config telemetry/cyclonedds-loopback.xml] [--no-telemetry]
 #include <google/protobuf/stubs/logging.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -16,6 +18,7 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,7 +26,9 @@
 #include "bus/wire/endpoint.hpp"
 #include "clock/asio_scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
+#include "orchestrator/broker_telemetry/broker_telemetry.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "telemetry/cli_options.hpp"
 
 namespace {
 
@@ -98,6 +103,15 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_option("--ready-file", ready_file,
                  "Once listening, write the bound endpoints there, one per line (for scripts and tests)");
+  bool telemetry_enabled = true;
+  double telemetry_period = 1.0;
+  canfleet::telemetry::DdsOptions dds;
+  app.add_flag("!--no-telemetry", telemetry_enabled, "Do not publish BusStats over DDS");
+  app.add_option("--telemetry-period", telemetry_period,
+                 "How often BusStats are sampled and republished, seconds")
+      ->check(CLI::Range(0.05, 3600.0))
+      ->capture_default_str();
+  canfleet::telemetry::AddDdsOptions(app, dds);
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_default_logger(spdlog::stderr_color_mt("canfleet-broker"));
@@ -115,6 +129,10 @@ int main(int argc, char** argv) {
   canfleet::AsioScheduler scheduler(io);
   canfleet::broker::Broker broker(scheduler);
   canfleet::transport::BrokerServer server(io, broker);
+  // Telemetry, destroyed before the broker and the scheduler it samples (declared after them).
+  std::optional<canfleet::telemetry::Participant> participant;
+  std::optional<canfleet::telemetry::OrchestratorTelemetry> publisher;
+  std::optional<canfleet::broker::BrokerTelemetry> telemetry;
   try {
     for (const auto& spec : bus_specs) {
       const BusConfig config = ParseBus(spec);
@@ -123,6 +141,22 @@ int main(int argc, char** argv) {
     }
     for (const auto& text : listens)
       server.Listen(canfleet::wire::Endpoint::Parse(text));
+    if (telemetry_enabled) {
+      const auto period = std::chrono::milliseconds(static_cast<long>(telemetry_period * 1000));
+      try {
+        participant.emplace(dds);
+        publisher.emplace(*participant, canfleet::telemetry::OrchestratorTelemetryOptions{.period = period});
+        telemetry.emplace(broker, scheduler, *publisher,
+                          canfleet::broker::BrokerTelemetryOptions{.period = period});
+        spdlog::info("telemetry: BusStats on DDS domain {}", dds.domain_id);
+      } catch (const canfleet::telemetry::DdsError& e) {
+        // The buses matter more than their monitoring: run without telemetry.
+        spdlog::error("telemetry: {}; running without telemetry", e.what());
+        telemetry.reset();
+        publisher.reset();
+        participant.reset();
+      }
+    }
     if (!ready_file.empty()) WriteReadyFile(ready_file, server.Endpoints());
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
@@ -140,6 +174,10 @@ int main(int argc, char** argv) {
     drain.async_wait([&](const asio::error_code&) { io.stop(); });
   });
   io.run();
+  // Dispose the buses' BusStats (monitors drop them) before the process goes.
+  telemetry.reset();
+  publisher.reset();
+  participant.reset();
   spdlog::info("stopped");
   return 0;
 }

@@ -18,7 +18,11 @@ struct SampleMeta {
   /// False for an instance-state notification: only the key fields of the sample are set, and the
   /// instance was disposed (its writer left cleanly) or lost all writers (the process died).
   bool valid_data = true;
-  bool alive = true;      ///< instance state is ALIVE
+  /// Instance state is ALIVE. Not only invalid samples can be not alive: when a writer's last
+  /// sample and its dispose (or the loss of all writers) reach the reader before it takes, that
+  /// valid sample comes with the NOT_ALIVE state and no invalid sample follows. Check `alive` on
+  /// every sample.
+  bool alive = true;
   bool disposed = false;  ///< NOT_ALIVE_DISPOSED (otherwise, when not alive: no writers)
 };
 

@@ -9,6 +9,9 @@
 //     process toggling a fault, FaultEvent); this process takes the samples and measures
 //     receive time - source timestamp (one host, one clock).
 //  4. RSS of a node-like process (participant + NodeStatus/IoSnapshot/Emcy writers).
+//  5. A real canfleet-node (Quad controller, idle in pre-operational, on a canfleet-broker bus)
+//     with telemetry at 1 Hz and with --no-telemetry: CPU from /proc/<pid>/stat over the
+//     measurement (start-up excluded) and RSS from /proc/<pid>/status, a monitor subscribed.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -25,6 +28,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -105,6 +109,41 @@ class Child {
   bool reaped_ = false;
 };
 
+/// utime + stime, seconds, from a /proc/.../stat file (fields 14 and 15).
+double StatCpuSeconds(const std::string& path) {
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');  // the command name may contain spaces
+  if (close == std::string::npos) return -1;
+  std::istringstream fields(text.substr(close + 2));
+  std::string field;
+  unsigned long long utime = 0, stime = 0;
+  for (int i = 3; i <= 15 && fields >> field; ++i) {
+    if (i == 14) utime = std::stoull(field);
+    if (i == 15) stime = std::stoull(field);
+  }
+  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+/// CPU seconds of a live process: all threads, and the main thread alone (the node's event loop;
+/// the other threads are Cyclone's and the telemetry publisher's).
+struct ProcessCpu {
+  double total = 0;
+  double main_thread = 0;
+};
+ProcessCpu ReadProcessCpu(pid_t pid) {
+  const std::string dir = "/proc/" + std::to_string(pid);
+  return {StatCpuSeconds(dir + "/stat"), StatCpuSeconds(dir + "/task/" + std::to_string(pid) + "/stat")};
+}
+
+/// A "VmRSS:"-style field of /proc/<pid>/status, kB.
+long ProcessStatusKb(pid_t pid, const std::string& field) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(field, 0) == 0) return std::stol(line.substr(field.size()));
+  return -1;
+}
+
 std::vector<std::string> FakeFleet(std::uint32_t domain, std::vector<std::string> extra) {
   std::vector<std::string> args = {CANFLEET_FAKE_FLEET, "--dds-domain", std::to_string(domain),
                                    "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG};
@@ -130,7 +169,7 @@ struct Monitor {
       : participant({.domain_id = domain, .config_file = CANFLEET_DDS_LOOPBACK_CONFIG}),
         reader(participant, {.node_status = [this](const auto& s, const auto& m) { OnStatus(s, m); },
                              .emcy = [this](const auto& s, const auto& m) { OnEvent(s.bus, m); },
-                             .io = {},
+                             .io = [this](const auto&, const auto& m) { ios += m.valid_data ? 1 : 0; },
                              .bus_stats = {},
                              .fault = [this](const auto& s, const auto& m) { OnFault(s, m); }}) {}
 
@@ -160,6 +199,7 @@ struct Monitor {
   Participant participant;
   FleetReader reader;
   std::uint64_t statuses = 0;
+  std::uint64_t ios = 0;
   std::set<int> nodes;
   bool recording = false;
   std::vector<std::chrono::system_clock::duration> emcy_latency;
@@ -293,6 +333,68 @@ void Memory() {
   }
 }
 
+/// Section 5: a real node process, telemetry on (1 Hz) and off.
+void RealNode(double seconds) {
+  constexpr std::uint32_t kDomain = 195;
+  const std::string ready = "/tmp/canfleet-telemetry-bench-" + std::to_string(getpid()) + ".ready";
+  std::remove(ready.c_str());
+  Child broker({CANFLEET_BROKER, "--bus", "bench0:500k", "--listen", "tcp://127.0.0.1:0", "--ready-file",
+                ready, "--log-level", "warn", "--no-telemetry"});
+  const auto start = Clock::now();
+  while (!std::ifstream(ready) && Clock::now() - start < 30s)
+    std::this_thread::sleep_for(20ms);
+  std::string endpoint;
+  std::getline(std::ifstream(ready) >> std::ws, endpoint);
+  std::remove(ready.c_str());
+  if (endpoint.empty()) throw std::runtime_error("canfleet-broker did not start");
+
+  Monitor monitor(kDomain);
+  for (const bool telemetry : {true, false}) {
+    std::vector<std::string> args = {CANFLEET_NODE,
+                                     "--device",
+                                     "quad-controller",
+                                     "--node-id",
+                                     "5",
+                                     "--bus",
+                                     "bench0@" + endpoint,
+                                     "--log-level",
+                                     "warn",
+                                     "--dds-domain",
+                                     std::to_string(kDomain),
+                                     "--dds-config",
+                                     CANFLEET_DDS_LOOPBACK_CONFIG};
+    if (!telemetry) args.push_back("--no-telemetry");
+    Child node(args);
+    monitor.Run(3s);  // start-up, connection, boot, discovery
+    const std::uint64_t statuses_before = monitor.statuses;
+    const std::uint64_t ios_before = monitor.ios;
+    const ProcessCpu before = ReadProcessCpu(node.pid());
+    const auto measured_from = Clock::now();
+    monitor.Run(std::chrono::milliseconds(static_cast<long>(seconds * 1000)));
+    const double elapsed = std::chrono::duration<double>(Clock::now() - measured_from).count();
+    const ProcessCpu after = ReadProcessCpu(node.pid());
+    const double cpu = (after.total - before.total) / elapsed;
+    const double main_cpu = (after.main_thread - before.main_thread) / elapsed;
+    const long rss = ProcessStatusKb(node.pid(), "VmRSS:");
+    const long hwm = ProcessStatusKb(node.pid(), "VmHWM:");
+    const long threads = ProcessStatusKb(node.pid(), "Threads:");
+    std::printf(
+        "| canfleet-node quad-controller, idle (pre-operational), telemetry %s | %.2f %% CPU (event loop "
+        "%.2f %%, other threads %.3f %%), RSS %.1f MB (peak %.1f MB) | %ld threads, %.1f NodeStatus + "
+        "%.1f IoSnapshot samples/s received |\n",
+        telemetry ? "on at 1 Hz" : "off (--no-telemetry)", cpu * 100, main_cpu * 100, (cpu - main_cpu) * 100,
+        static_cast<double>(rss) / 1024.0, static_cast<double>(hwm) / 1024.0, threads,
+        static_cast<double>(monitor.statuses - statuses_before) / elapsed,
+        static_cast<double>(monitor.ios - ios_before) / elapsed);
+    kill(node.pid(), SIGTERM);
+    std::string out;
+    node.Finish(&out);
+  }
+  kill(broker.pid(), SIGTERM);
+  std::string out;
+  broker.Finish(&out);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -302,16 +404,23 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds, "measurement time per CPU/latency figure")->capture_default_str();
   app.add_option("--publishers", publisher_counts, "publisher process counts for the latency figures")
       ->capture_default_str();
+  std::set<std::string> sections{"caller", "cpu", "latency", "memory", "node"};
+  app.add_option("--sections", sections, "which measurements: caller, cpu, latency, memory, node")
+      ->check(CLI::IsMember({"caller", "cpu", "latency", "memory", "node"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   signal(SIGPIPE, SIG_IGN);
   try {
     std::printf("| measurement | figure | notes |\n|---|---|---|\n");
-    CallerCost();
-    CpuPerNode(seconds);
-    for (const int n : publisher_counts)
-      Latency(n, 1, seconds);   // one process per node, as the real fleet
-    Latency(100, 20, seconds);  // 100 publishers in fewer DDS processes
-    Memory();
+    if (sections.count("caller")) CallerCost();
+    if (sections.count("cpu")) CpuPerNode(seconds);
+    if (sections.count("latency")) {
+      for (const int n : publisher_counts)
+        Latency(n, 1, seconds);   // one process per node, as the real fleet
+      Latency(100, 20, seconds);  // 100 publishers in fewer DDS processes
+    }
+    if (sections.count("memory")) Memory();
+    if (sections.count("node")) RealNode(seconds);
   } catch (const std::exception& e) {
     std::cerr << "canfleet_telemetry_bench: " << e.what() << '\n';
     return 1;

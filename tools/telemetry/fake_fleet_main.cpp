@@ -1,7 +1,8 @@
 // canfleet-fake-fleet: publishes the telemetry of a synthetic fleet (NodeStatus, IoSnapshot, Emcy
 // and, with --orchestrator, BusStats and FaultEvent) through the real publishers. For the
-// telemetry tests, benchmarks and README captures until real nodes publish; a stand-in for node
-// processes, not a simulation of CANopen.
+// telemetry tests and benchmarks that need many nodes or scripted faults cheaply; a stand-in for
+// node processes, not a simulation of CANopen (canfleet-node and canfleet-broker publish the real
+// thing).
 //
 // Faults are driven by command-line timings or by commands on stdin (one per line; each answered
 // with "ok <command>" on stdout once handed to the publishers):

@@ -68,22 +68,34 @@ void FleetView::Emit(FleetEvent event, std::vector<FleetEvent>* events) {
 
 void FleetView::Apply(const NodeStatusSample& sample, const SampleMeta& meta,
                       std::vector<FleetEvent>* events) {
+  if (meta.valid_data) ApplyStatus(sample, meta, events);
+  // The instance state counts whether or not the sample carries data. A node's last status and its
+  // dispose (or the loss of its writers) that reach the reader before it takes arrive as one valid
+  // sample whose instance state is already NOT_ALIVE: Cyclone then queues no separate invalid
+  // sample, and the instance is gone from the reader once taken. Looking only at invalid samples
+  // kept such a node alive for ever (the flaky "node seen leaving" check of issue 7).
+  if (!meta.alive) MarkGone(sample.key(), meta, events);
+}
+
+void FleetView::MarkGone(const NodeKey& key, const SampleMeta& meta, std::vector<FleetEvent>* events) {
+  const auto it = nodes_.find(key);
+  if (it == nodes_.end() || !it->second.alive) return;
+  it->second.alive = false;
+  it->second.disposed = meta.disposed;
+  it->second.last_change = meta.source_time;
+  Emit({.time = meta.source_time,
+        .kind = EventKind::kNodeGone,
+        .bus = key.bus,
+        .node_id = key.node_id,
+        .from = "",
+        .to = meta.disposed ? "disposed" : "no-writers"},
+       events);
+}
+
+void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& meta,
+                            std::vector<FleetEvent>* events) {
   const NodeKey key = sample.key();
   auto it = nodes_.find(key);
-  if (!meta.valid_data) {  // instance state change only: the node left or died
-    if (it == nodes_.end() || !it->second.alive) return;
-    it->second.alive = false;
-    it->second.disposed = meta.disposed;
-    it->second.last_change = meta.source_time;
-    Emit({.time = meta.source_time,
-          .kind = EventKind::kNodeGone,
-          .bus = key.bus,
-          .node_id = key.node_id,
-          .from = "",
-          .to = meta.disposed ? "disposed" : "no-writers"},
-         events);
-    return;
-  }
   if (it == nodes_.end()) {
     NodeRow row;
     row.status = sample;
@@ -172,15 +184,15 @@ void FleetView::Apply(const EmcySample& sample, const SampleMeta& meta, std::vec
 void FleetView::Apply(const IoSnapshotSample& sample, const SampleMeta& meta, std::vector<FleetEvent>*) {
   auto it = nodes_.find({sample.bus, sample.node_id});
   if (it == nodes_.end()) return;  // I/O is shown with its node; the status arrives within a period
-  if (meta.valid_data) {
+  if (meta.valid_data && meta.alive) {
     it->second.io = sample;
-  } else {
+  } else {  // disposed or without writers, with or without data (see the NodeStatus Apply)
     it->second.io.reset();
   }
 }
 
 void FleetView::Apply(const BusStatsSample& sample, const SampleMeta& meta, std::vector<FleetEvent>*) {
-  if (!meta.valid_data) {
+  if (!meta.valid_data || !meta.alive) {  // the bus was removed or its publisher left
     buses_[sample.bus].stats.reset();
     return;
   }

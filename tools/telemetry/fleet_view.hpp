@@ -91,6 +91,8 @@ class FleetView {
 
  private:
   void Emit(FleetEvent event, std::vector<FleetEvent>* events);
+  void ApplyStatus(const NodeStatusSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
+  void MarkGone(const NodeKey& key, const SampleMeta& meta, std::vector<FleetEvent>* events);
 
   WallTime started_{};
   std::size_t recent_capacity_{};

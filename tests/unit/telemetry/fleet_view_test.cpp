@@ -94,6 +94,37 @@ TEST(FleetView, DisposeMeansGoneAndTheNextStatusMeansBack) {
   EXPECT_EQ(events[0].from, "gone");
 }
 
+// Issue 7's "node seen leaving" bug: a status whose instance was disposed before the reader took it
+// arrives as valid data with the NOT_ALIVE_DISPOSED state, and no invalid sample follows.
+TEST(FleetView, AValidSampleOfADisposedInstanceMeansGone) {
+  FleetView view(kStart);
+  view.Apply(Status(3), At(kStart + 1s), nullptr);
+  std::vector<FleetEvent> events;
+  view.Apply(Status(3, NmtState::kStopped),
+             {.source_time = kStart + 2s, .valid_data = true, .alive = false, .disposed = true}, &events);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, EventKind::kNmt);  // the last status is applied first
+  EXPECT_EQ(events[1].kind, EventKind::kNodeGone);
+  EXPECT_EQ(events[1].to, "disposed");
+  const NodeRow& row = view.nodes().at({"can0", 3});
+  EXPECT_FALSE(row.alive);
+  EXPECT_TRUE(row.disposed);
+  EXPECT_EQ(row.status.nmt_state, NmtState::kStopped);
+}
+
+// A late monitor whose first sample of a node is already without writers (the process died).
+TEST(FleetView, AFirstSampleWithoutWritersIsSeenThenGone) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  view.Apply(Status(4), {.source_time = kStart + 1s, .valid_data = true, .alive = false, .disposed = false},
+             &events);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].kind, EventKind::kNodeSeen);
+  EXPECT_EQ(events[1].kind, EventKind::kNodeGone);
+  EXPECT_EQ(events[1].to, "no-writers");
+  EXPECT_FALSE(view.nodes().at({"can0", 4}).alive);
+}
+
 TEST(FleetView, EventsOlderThanTheMonitorAreReplays) {
   FleetView view(kStart);
   std::vector<FleetEvent> events;

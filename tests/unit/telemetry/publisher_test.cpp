@@ -7,6 +7,7 @@
 #include "telemetry/node_telemetry.hpp"
 #include "telemetry/orchestrator_telemetry.hpp"
 #include "test_dds.hpp"
+#include "tools/telemetry/fleet_view.hpp"
 
 namespace canfleet::telemetry {
 namespace {
@@ -203,6 +204,32 @@ TEST(NodeTelemetry, DestroyingThePublisherDisposesTheNode) {
   ASSERT_TRUE(monitor.Until([&] { return !monitor.status.back().second.valid_data; }));
   EXPECT_TRUE(monitor.status.back().second.disposed);
   EXPECT_EQ(monitor.status.back().first.node_id, 5);
+}
+
+// Issue 7's "node seen leaving" bug, made deterministic: the reader does not take anything until
+// the publisher is gone, so the last status and the dispose meet in the reader's cache. Cyclone
+// then delivers one valid sample whose instance state is NOT_ALIVE_DISPOSED, and nothing after it.
+TEST(NodeTelemetry, ALastStatusAndItsDisposeTakenTogetherStillMeanGone) {
+  Participant participant(TestDds(22));
+  Collector monitor(participant);
+  auto telemetry = std::make_unique<NodeTelemetry>(participant, Options("together"));
+  NodeStatusSnapshot status;
+  status.nmt_state = NmtState::kOperational;
+  telemetry->UpdateStatus(status);
+  telemetry->Flush();
+  telemetry.reset();  // deleting the writer waits until the readers acknowledged its data
+
+  ASSERT_TRUE(monitor.Until([&] { return !monitor.status.empty() && !monitor.status.back().second.alive; }));
+  const auto& [last, meta] = monitor.status.back();
+  EXPECT_TRUE(meta.disposed);
+  EXPECT_EQ(last.node_id, 5);
+  // What monitors make of it: the node left, whether or not the last sample carried data.
+  tools::FleetView view(std::chrono::system_clock::now());
+  for (const auto& [sample, m] : monitor.status)
+    view.Apply(sample, m, nullptr);
+  ASSERT_EQ(view.nodes().count({"together", 5}), 1u);
+  EXPECT_FALSE(view.nodes().at({"together", 5}).alive);
+  EXPECT_TRUE(view.nodes().at({"together", 5}).disposed);
 }
 
 TEST(NodeTelemetry, RejectsOptionsBeyondTheIdlBounds) {
