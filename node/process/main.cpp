@@ -16,6 +16,8 @@
 #include "node/devices/device_node.hpp"
 #include "node/devices/registry.hpp"
 #include "node/process/node_options.hpp"
+#include "node/process/node_telemetry_wiring.hpp"
+#include "node/process/remote_io.hpp"
 #include "node/process/stdin_control.hpp"
 
 namespace {
@@ -56,8 +58,9 @@ std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spe
   return port;
 }
 
-int Run(const node::NodeOptions& options) {
-  auto log = spdlog::stdout_color_mt(options.name);
+int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemetry_settings) {
+  // Logs on stderr: stdout carries --stdin-control replies, which scripts read line by line.
+  auto log = spdlog::stderr_color_mt(options.name);
   log->set_level(spdlog::level::from_str(options.log_level));
   spdlog::set_default_logger(log);
 
@@ -88,6 +91,7 @@ int Run(const node::NodeOptions& options) {
   settings.hooks.on_storage_issue = [log](const std::string& text) {
     log->warn("stored parameters: {}", text);
   };
+  auto telemetry = node::StartNodeTelemetry(telemetry_settings, settings, *log);  // DDS (issue 7)
 
   std::unique_ptr<devices::DeviceNode> node;
   std::size_t connected_ports = 0;
@@ -106,6 +110,12 @@ int Run(const node::NodeOptions& options) {
     raw_ports.push_back(ports.back().get());
   }
   node = std::make_unique<devices::DeviceNode>(std::move(device), scheduler, raw_ports, settings);
+  if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options));
+  // Remote I/O: the orchestrator sets and reads the simulated I/O over the broker connection.
+  for (auto& port : ports)
+    if (auto* client = dynamic_cast<BrokerClientPort*>(port.get()))
+      client->OnNodeRequest(
+          [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
   for (const auto& assignment : options.io) {
     auto eq = assignment.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("--io " + assignment + ": expected NAME=VALUE");
@@ -128,6 +138,7 @@ int Run(const node::NodeOptions& options) {
   io.run();
   // Destroy the node (its timers and hooks) before the ports and the scheduler it uses.
   control.reset();
+  telemetry.reset();  // disposes the node's DDS instances: monitors see it leave
   node.reset();
   return 0;
 }
@@ -157,7 +168,15 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--list-devices", list, "list the device variants and exit");
   app.add_flag("--version", version, "print the version and exit");
-  CLI11_PARSE(app, argc, argv);
+  canfleet::node::TelemetrySettings telemetry;
+  canfleet::node::AddTelemetryOptions(app, telemetry);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version are "errors" with code 0; every real argument error exits 2.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
 
   if (version) {
     std::cout << kVersion << "\n";
@@ -183,7 +202,7 @@ int main(int argc, char** argv) {
       options.name = (options.device.empty() ? options.eds.stem().string() : options.device) + "@" +
                      std::to_string(node_ids[0]);
     }
-    return Run(options);
+    return Run(options, telemetry);
   } catch (const std::exception& e) {
     std::cerr << "canfleet-node: " << e.what() << "\n";
     return 2;

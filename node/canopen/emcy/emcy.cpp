@@ -126,13 +126,13 @@ void Emcy::Raise(const ErrorEntry& error) {
   Emit(error.code, error.msef);
 }
 
-void Emcy::Clear(std::uint16_t code, std::uint16_t info) {
+void Emcy::Clear(std::uint16_t code, std::uint16_t info, bool keep_in_history) {
   auto it = std::find_if(active_.begin(), active_.end(),
                          [&](const ErrorEntry& e) { return e.code == code && e.info == info; });
   if (it == active_.end()) return;
   const std::uint32_t value = it->HistoryValue();
   active_.erase(it);
-  if (options_.remove_cleared_from_history) RemoveFromHistory(value);
+  if (options_.remove_cleared_from_history && !keep_in_history) RemoveFromHistory(value);
   RecomputeRegister();
   SyncRegister();
   SyncHistory();
@@ -189,7 +189,7 @@ void Emcy::Emit(std::uint16_t code, const std::array<std::uint8_t, 5>& msef) {
   std::copy(msef.begin(), msef.end(), frame.data.begin() + 3);
   const TimePoint now = scheduler_.Now();
   const bool inhibited = last_transmit_ && now < *last_transmit_ + inhibit_time_;
-  if (queue_size_ == 0 && !inhibited) {
+  if (queue_size_ == 0 && !inhibited && !held_by_bus_off_) {
     Transmit(frame);
     return;
   }
@@ -201,7 +201,7 @@ void Emcy::Emit(std::uint16_t code, const std::array<std::uint8_t, 5>& msef) {
   }
   queue_[(queue_head_ + queue_size_) % kQueueCapacity] = frame;
   ++queue_size_;
-  if (!inhibit_timer_.Armed()) inhibit_timer_.StartAt(*last_transmit_ + inhibit_time_);
+  if (!inhibit_timer_.Armed() && !held_by_bus_off_) inhibit_timer_.StartAt(*last_transmit_ + inhibit_time_);
 }
 
 void Emcy::Transmit(CanFrame frame) {
@@ -211,13 +211,32 @@ void Emcy::Transmit(CanFrame frame) {
   // The inhibit time runs from the attempt: a controller that refuses the frame (bus-off) does
   // not make the producer send faster.
   last_transmit_ = scheduler_.Now();
-  if (!port_.Send(frame)) return;
+  if (!port_.Send(frame)) {
+    // A bus-off controller refuses everything; the frame waits at the head of the queue for
+    // OnBusOffEnded (a full queue or an invalid frame loses it, as before).
+    if (port_.State() == ControllerState::kBusOff && queue_size_ < kQueueCapacity) {
+      queue_head_ = (queue_head_ + kQueueCapacity - 1) % kQueueCapacity;
+      queue_[queue_head_] = frame;
+      ++queue_size_;
+      held_by_bus_off_ = true;
+      inhibit_timer_.Cancel();
+    }
+    return;
+  }
   last_sent_ = frame;
   if (on_sent_) on_sent_(frame);
 }
 
-void Emcy::OnInhibitExpired() {
+void Emcy::OnBusOffEnded() {
+  if (!held_by_bus_off_) return;
+  held_by_bus_off_ = false;
   if (queue_size_ == 0) return;
+  const TimePoint now = scheduler_.Now();
+  inhibit_timer_.StartAt(last_transmit_ ? std::max(now, *last_transmit_ + inhibit_time_) : now);
+}
+
+void Emcy::OnInhibitExpired() {
+  if (queue_size_ == 0 || held_by_bus_off_) return;
   if (!MaySend()) {
     DropQueue();
     return;
@@ -232,6 +251,7 @@ void Emcy::OnInhibitExpired() {
 void Emcy::DropQueue() {
   queue_head_ = 0;
   queue_size_ = 0;
+  held_by_bus_off_ = false;
   inhibit_timer_.Cancel();
 }
 

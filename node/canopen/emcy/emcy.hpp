@@ -96,7 +96,9 @@ class Emcy {
   /// 1001h is recomputed, and an error-reset EMCY goes out (CiA 301 §7.2.7.1): code 0000h, the new
   /// 1001h, manufacturer bytes zero. With other errors still active it is sent only when
   /// reset_emcy_on_partial_clear. Nothing happens when (code, info) is not active.
-  void Clear(std::uint16_t code, std::uint16_t info);
+  /// `keep_in_history`: the 1003h entry stays whatever the option says — for errors that name an
+  /// event rather than a condition (8140h "recovered from bus-off" ends the moment it is sent).
+  void Clear(std::uint16_t code, std::uint16_t info, bool keep_in_history = false);
 
   /// Forgets every active error and the history, drops waiting frames and the inhibit state, and
   /// sets 1001h to 0, without sending anything: the reset-node path (the node boots again).
@@ -121,6 +123,11 @@ class Emcy {
   void OnSent(std::function<void(const CanFrame&)> listener) { on_sent_ = std::move(listener); }
   /// Frames dropped because the inhibit queue was full.
   std::size_t Overruns() const { return overruns_; }
+
+  /// The controller is back from bus-off: frames the port refused while bus-off (above all the
+  /// 8140h "recovered from bus-off" EMCY raised at bus-off) go out now, in order, inhibit time
+  /// permitting — as CANopenNode's EMCY FIFO sends them once the controller transmits again.
+  void OnBusOffEnded();
 
  private:
   /// A 1014h CAN-ID (11-bit) that stands for "80h + node-ID".
@@ -173,6 +180,7 @@ class Emcy {
   std::size_t queue_head_ = 0;
   std::size_t queue_size_ = 0;
   std::size_t overruns_ = 0;
+  bool held_by_bus_off_ = false;  // the queue's head was refused by a bus-off controller
 
   std::optional<CanFrame> last_sent_;
   std::function<void(const CanFrame&)> on_sent_;

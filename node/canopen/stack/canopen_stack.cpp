@@ -164,7 +164,10 @@ void CanopenStack::OnControllerEvent(const ControllerEvent& event) {
   ControllerState before = controller_.state;
   controller_ = event;
   if (before == event.state) return;
-  if (before == ControllerState::kBusOff) OnCommError({CommErrorKind::kBusOff}, false);
+  if (before == ControllerState::kBusOff) {
+    emcy_.OnBusOffEnded();  // the 8140h raised at bus-off leaves first
+    OnCommError({CommErrorKind::kBusOff}, false);
+  }
   if (before == ControllerState::kErrorPassive) OnCommError({CommErrorKind::kErrorPassive}, false);
   if (event.state == ControllerState::kBusOff) OnCommError({CommErrorKind::kBusOff}, true);
   if (event.state == ControllerState::kErrorPassive) OnCommError({CommErrorKind::kErrorPassive}, true);
@@ -183,7 +186,9 @@ void CanopenStack::OnCommError(const CommError& error, bool active) {
         if (reaction == 2 && nmt_.State() != NmtState::kStopped) nmt_.SetState(NmtState::kStopped);
       }
     } else {
-      emcy_.Clear(encoding->entry.code, encoding->entry.info);
+      // 8140h means "recovered from bus-off": an event, so its 1003h entry is history the master
+      // reads after the recovery (it could not read anything during bus-off).
+      emcy_.Clear(encoding->entry.code, encoding->entry.info, error.kind == CommErrorKind::kBusOff);
     }
   }
   if (hooks_.on_comm_error) hooks_.on_comm_error(error, active);

@@ -156,6 +156,36 @@ TEST_F(QuadAiTest, DisabledInputReadsZero) {
   EXPECT_EQ(Read(0x7130, 4), 0);
 }
 
+// Appendix A, Table 1.0 "Disable Inputs": "When disable is selected, no CAN messages associated
+// with that channel are sent to the network"; §3.3.14 mode 0 = "Channel not used". A disabled
+// input is never checked (no EMCY however far out of range it is) and causes no PDO event; the
+// manual gives it no value, so in a TPDO shared with enabled channels its bytes read 0 (README
+// choice 16). Enabled again, the same input is checked and reported at once.
+TEST_F(QuadAiTest, ADisabledInputSendsNothingOfItsOwn) {
+  Write(0x6112, 2, 0, 1);     // AIN2 disabled
+  Write(0x20B0, 2, 0, 2);     // no error delay
+  Write(0x20A0, 1, 0x02, 1);  // error checking on AIN2
+  Start();
+  SetNumber("AIN1.voltage_mV", 1000);
+  SetNumber("AIN2.voltage_mV", 4900);  // above 2080h (4800): an error, were it checked
+  SetNumber("AIN3.voltage_mV", 3000);
+  SetNumber("AIN4.voltage_mV", 4000);
+  Advance(99ms);  // t = 100 ms: the event timers
+  std::vector<std::string> tpdo1, emcy;
+  for (const auto& f : Frames()) {
+    if (f.starts_with("185#")) tpdo1.push_back(f);
+    if (f.starts_with("085#")) emcy.push_back(f);
+  }
+  EXPECT_EQ(tpdo1, std::vector<std::string>{"185#E8030000B80BA00F"});
+  EXPECT_TRUE(emcy.empty()) << ::testing::PrintToString(emcy);
+  EXPECT_EQ(Read(0x1003, 0), 0);
+  EXPECT_EQ(Read(0x6000, 1), 0);  // §3.2: not a digital input either
+
+  Write(0x6112, 2, 1, 1);  // normal operation again
+  Advance(10ms);
+  EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0xFF01, 0x01, 2, 0x01)});
+}
+
 // §3.3.13, §3.3.14: a value not listed → SDO abort, previous value unchanged.
 TEST_F(QuadAiTest, InvalidSensorTypeOrModeIsRefusedAndTheOldValueKept) {
   EXPECT_EQ(TryWrite(0x6110, 1, 41, 2), SdoAborted(0x6110, 1, 0x06090030));

@@ -154,6 +154,51 @@ TEST_F(QuadAoTest, DitherIsSuperimposedWhileTheOutputDrivesCurrent) {
   EXPECT_EQ(TryWrite(0x3060, 1, 40, 2), SdoAborted(0x3060, 1, 0x06090032));  // 50-400 Hz
 }
 
+// §2.6 "Manufacturer dither objects 3060h (frequency) and 3070h (amplitude) apply regardless of
+// which control signal is selected": an input-controlled output dithers too. §3.5.6-7: the dither
+// belongs to the proportional outputs, so a POUT switched as a digital output (6310h = 1000) has
+// none. The waveform itself is not sampled (README choice 20): amplitude and frequency are
+// reported, 30C0h is the mean current.
+TEST_F(QuadAoTest, DitherAppliesUnderInputControlButNotToADigitalOutput) {
+  Write(0x30A0, 1, 0, 1);              // no ramps
+  Write(0x3010, 1, 1, 1);              // POUT1 <- AIN1, single profile
+  Write(0x3070, 1, 250, 2);            // 250 mA
+  Write(0x3060, 1, 80, 2);             // 80 Hz
+  SetNumber("AIN1.voltage_mV", 4500);  // 2070h: the maximum current, 1500 mA
+  Advance(10ms);
+  EXPECT_EQ(Current(1), 1500);
+  EXPECT_EQ(io().Number("POUT1.dither_mA"), 250);
+  EXPECT_EQ(io().Number("POUT1.dither_Hz"), 80);
+  EXPECT_EQ(Read(0x30C0, 1), 1500);
+
+  Write(0x6310, 1, 1000, 2);  // §3.5.15: POUT1 becomes a digital output
+  Write(0x3001, 1, 1, 1);     // §3.4.1: controlled by AIN1 as ON/OFF (4500 mV >= 2002h 3500 mV)
+  Advance(10ms);
+  EXPECT_TRUE(io().Bool("POUT1.on"));
+  EXPECT_EQ(Current(1), 1000);  // the load's current
+  EXPECT_EQ(io().Number("POUT1.dither_mA"), 0);
+  EXPECT_EQ(io().Number("POUT1.dither_Hz"), 0);
+}
+
+// §1.1 "Total current consumption of all the outputs combined must not exceed 6A" and Appendix A
+// "The maximum total current draw on the power supply pins is 6 Amps": a rating for whoever wires
+// the loads. The manual gives the controller no reaction to it (no limiting, no EMCY code in
+// §4.1), so four POUTs at 2 A and DOUT on are all driven as commanded, without a fault
+// (README choice 21).
+TEST_F(QuadAoTest, TheSixAmpereTotalIsARatingNotALimit) {
+  Start();
+  Send("205#D007D007D007D007");  // RPDO1: 4 x 2000 mA
+  Send("305#10");                // RPDO2: 6200h bit 4, DOUT on
+  Advance(1ms);
+  for (int n = 1; n <= 4; ++n)
+    EXPECT_EQ(Current(n), 2000) << "POUT" << n;
+  EXPECT_TRUE(io().Bool("DOUT.on"));
+  Advance(2000ms);  // longer than every error delay
+  EXPECT_TRUE(Frames("085#").empty());
+  EXPECT_EQ(Read(0x1001, 0), 0);
+  EXPECT_EQ(Current(4), 2000);
+}
+
 // §4.2: SDO writes that control outputs are refused in pre-operational; §3.5.20 an open load
 // draws no current although the driver is on.
 TEST_F(QuadAoTest, PreOperationalRefusesOutputWritesAndAnOpenLoadDrawsNothing) {

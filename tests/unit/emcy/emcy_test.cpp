@@ -178,6 +178,25 @@ TEST_F(EmcyTest, LastSentAndOnSentReportAcceptedFrames) {
   EXPECT_EQ(probe.Count(), 1u);
 }
 
+// CiA 301 8140h means "recovered from bus-off": the EMCY raised while the controller is bus-off
+// cannot leave then, so it waits and is the first frame after recovery, followed by the error
+// reset sent when the error clears (CANopenNode's EMCY FIFO behaves the same).
+TEST_F(EmcyTest, EmcyRefusedDuringBusOffLeavesAfterRecoveryInOrder) {
+  auto& emcy = Start();
+  node.SetControllerState({ControllerState::kBusOff, 256, 0});
+  emcy.Raise(Error(0x8140, 0x0000, 0x10));
+  emcy.Raise(Error(0x2320, 0x0403, kErrorRegisterCurrent, {4, 3, 0, 0, 0}));
+  scheduler.Advance(std::chrono::seconds(1));
+  EXPECT_EQ(probe.Count(), 0u);
+  node.SetControllerState({ControllerState::kErrorActive, 0, 0});
+  emcy.OnBusOffEnded();
+  emcy.Clear(0x8140, 0x0000);
+  scheduler.Advance(std::chrono::milliseconds(1));
+  EXPECT_EQ(probe.Take(), (std::vector<std::string>{"085#4081110000000000", "085#2023130403000000",
+                                                    "085#0000030000000000"}));
+  EXPECT_FALSE(emcy.IsActive(0x8140, 0));
+}
+
 // Reset node: everything is forgotten without a frame (the node boots again).
 TEST_F(EmcyTest, ClearAllForgetsErrorsAndHistorySilently) {
   auto& emcy = Start();

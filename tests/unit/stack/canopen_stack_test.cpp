@@ -139,6 +139,25 @@ TEST_F(StackTest, BusOffIsRecordedIn1003hAndClearsOnRecovery) {
   EXPECT_EQ(stack->emcy().ActiveCount(), 0u);
 }
 
+// The 8140h EMCY raised at bus-off could not be sent then: it is the first frame after recovery,
+// then the error reset; 1003h keeps 00008140h as history for the master to read afterwards.
+TEST_F(StackTest, BusOffEmcyIsSentAfterRecoveryAndStaysIn1003h) {
+  stack->Start();
+  master.Send("000#0105");
+  master.Clear();
+  node_port.SetControllerState({ControllerState::kBusOff, 256, 0});
+  scheduler.Advance(std::chrono::milliseconds(100));
+  node_port.SetControllerState({ControllerState::kErrorActive, 0, 0});
+  scheduler.Advance(std::chrono::milliseconds(10));
+  std::vector<std::string> emcy;
+  for (const auto& frame : master.Take())
+    if (frame.rfind("085#", 0) == 0) emcy.push_back(frame);
+  EXPECT_EQ(emcy, (std::vector<std::string>{"085#4081110000000000", "085#0000000000000000"}));
+  EXPECT_EQ(od.GetUnsigned(0x1003, 0), 1u);
+  EXPECT_EQ(od.GetUnsigned(0x1003, 1), 0x00008140u);
+  EXPECT_EQ(od.GetUnsigned(0x1001, 0), 0u);
+}
+
 // CiA 305: configure node-ID while in configuration mode, then switch back to waiting: the node
 // resets communication with the new ID, and its predefined COB-IDs follow.
 TEST_F(StackTest, LssNodeIdChangeRebootsWithTheNewId) {
