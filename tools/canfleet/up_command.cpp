@@ -1,0 +1,95 @@
+// canfleet up FILE, canfleet down, canfleet check FILE.
+#include <iostream>
+#include <memory>
+#include "telemetry/cli_options.hpp"
+
+#include "orchestrator/fleet/run_fleet.hpp"
+#include "orchestrator/topology/topology_loader.hpp"
+#include "tools/canfleet/cli.hpp"
+
+namespace canfleet::cli {
+
+namespace {
+
+struct UpArgs {
+  std::string topology;
+  std::string listen;
+  std::string node_binary;
+  std::string ready_file;
+  std::string log_level = "info";
+  bool no_start = false;
+  bool telemetry = true;
+  telemetry::DdsOptions dds;
+};
+
+int RunUp(const GlobalOptions& global, const UpArgs& args) {
+  fleet::UpOptions options;
+  options.topology = args.topology;
+  if (global.control_given) options.control = global.control;
+  if (!args.listen.empty()) options.listen = args.listen;
+  options.node_binary = args.node_binary;
+  options.ready_file = args.ready_file;
+  options.log_level = args.log_level;
+  options.no_start = args.no_start;
+  options.telemetry = args.telemetry;
+  options.dds_domain = args.dds.domain_id;
+  options.dds_config = args.dds.config_file;
+  return fleet::RunFleet(options);
+}
+
+std::string Plural(int n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+int RunCheck(const std::string& file) {
+  try {
+    const topology::LoadedTopology loaded = topology::LoadTopology(file);
+    std::cout << "ok: " << Plural(loaded.spec.bus_size(), "bus", "buses") << ", "
+              << Plural(loaded.spec.node_size(), "node", "nodes") << '\n';
+    return kExitOk;
+  } catch (const topology::TopologyError& e) {
+    std::cerr << e.what() << '\n';
+    return kExitUsage;
+  }
+}
+
+}  // namespace
+
+void AddUpCommands(CLI::App& app, Cli& cli) {
+  auto args = std::make_shared<UpArgs>();
+  CLI::App* up = app.add_subcommand("up", "Run the fleet of a topology file until Ctrl-C or `canfleet down`");
+  up->footer("--control (or CANFLEET_CONTROL) overrides where the topology says the control API listens.");
+  up->add_option("FILE", args->topology, "Topology file (protobuf text format)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  up->add_option("--listen", args->listen,
+                 "Broker endpoint for nodes, overriding the topology (tcp://HOST:PORT)");
+  up->add_option("--node-binary", args->node_binary,
+                 "canfleet-node to start (default: beside canfleet, then PATH)");
+  up->add_option("--ready-file", args->ready_file,
+                 "Written once every node booted: \"control <endpoint>\" and \"broker <endpoint>\" lines");
+  up->add_option("--log-level", args->log_level, "Orchestrator log level")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  up->add_flag("--no-start", args->no_start, "Start the buses but no node processes");
+  up->add_flag("!--no-telemetry", args->telemetry, "Do not publish BusStats and FaultEvents over DDS");
+  telemetry::AddDdsOptions(*up, args->dds);
+  up->callback([&cli, args] { cli.action = [&cli, args] { return RunUp(cli.global, *args); }; });
+
+  CLI::App* down = app.add_subcommand("down", "Stop every node process and the orchestrator");
+  down->callback([&cli] {
+    cli.action = [&cli] {
+      control::Request request;
+      request.mutable_shutdown();
+      PrintDone(Call(cli.global, request), "orchestrator stopping");
+      return kExitOk;
+    };
+  });
+
+  auto file = std::make_shared<std::string>();
+  CLI::App* check =
+      app.add_subcommand("check", "Load and validate a topology file without starting anything");
+  check->add_option("FILE", *file, "Topology file")->required();
+  check->callback([&cli, file] { cli.action = [file] { return RunCheck(*file); }; });
+}
+
+}  // namespace canfleet::cli
