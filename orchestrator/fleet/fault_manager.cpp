@@ -1,0 +1,421 @@
+#include "orchestrator/fleet/fault_manager.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "orchestrator/control/fault_text.hpp"
+
+namespace canfleet::fleet {
+
+using control::FaultKind;
+
+struct FaultManager::Fault {
+  std::uint32_t id = 0;
+  control::FaultSpec spec;
+  std::string summary;
+  std::string state = "active";
+  TimePoint started{};
+  TimePoint ended{};
+  std::string bus;                     ///< where it acts
+  std::vector<broker::RuleId> rules;   ///< on `bus`
+  std::optional<broker::PortId> port;  ///< controller faults, babbling idiot
+  std::uint64_t ended_hits = 0;        ///< hits of rules already removed
+  std::uint64_t babble_base = 0;       ///< the port's babble_frames when the fault began
+  std::unique_ptr<Timer> expiry;
+};
+
+namespace {
+
+constexpr std::uint32_t kStandardMask = 0x7FF;
+constexpr std::uint32_t kExtendedMask = 0x1FFFFFFF;
+
+bool Active(const std::string& state) {
+  return state == "active";
+}
+
+}  // namespace
+
+FaultManager::FaultManager(Context context) : ctx_(std::move(context)) {}
+
+FaultManager::~FaultManager() {
+  // Leave the broker clean, quietly: whoever listened to fault events may already be gone.
+  ctx_.on_event = nullptr;
+  for (auto& fault : faults_)
+    if (Active(fault->state)) End(*fault, "cleared");
+}
+
+double FaultManager::Seconds(TimePoint t) const {
+  return std::chrono::duration<double>(t - ctx_.origin).count();
+}
+
+const FleetNode& FaultManager::Node(const std::string& name) const {
+  if (name.empty()) throw FaultError("this fault needs --node");
+  const FleetNode* node = ctx_.find_node(name);
+  if (!node) throw FaultError("no node called '" + name + "' in this fleet");
+  return *node;
+}
+
+broker::PortId FaultManager::PortOf(const std::string& bus, const std::string& node) const {
+  std::optional<broker::PortId> found;
+  for (const auto& port : ctx_.broker.Ports(bus))
+    if (port.name == node) found = port.id;  // the newest attachment wins
+  if (!found) throw FaultError("node '" + node + "' is not attached to bus " + bus + " right now");
+  return *found;
+}
+
+std::string FaultManager::BusFor(const control::FaultSpec& spec) const {
+  if (!spec.bus().empty()) {
+    const auto buses = ctx_.broker.Buses();
+    if (std::find(buses.begin(), buses.end(), spec.bus()) == buses.end())
+      throw FaultError("no bus called '" + spec.bus() + "'");
+    if (!spec.node().empty() && Node(spec.node()).PortOn(spec.bus()) < 0)
+      throw FaultError("node '" + spec.node() + "' is not on bus " + spec.bus());
+    return spec.bus();
+  }
+  if (!spec.node().empty()) return Node(spec.node()).buses.front();
+  const auto buses = ctx_.broker.Buses();
+  if (buses.size() == 1) return buses.front();
+  throw FaultError("say which bus (--bus)");
+}
+
+std::vector<broker::PortId> FaultManager::ReceiverPorts(const std::string& bus,
+                                                        const control::FaultSpec& spec) const {
+  std::vector<broker::PortId> ports;
+  for (const auto& name : spec.receivers()) {
+    if (Node(name).PortOn(bus) < 0) throw FaultError("receiver '" + name + "' is not on bus " + bus);
+    ports.push_back(PortOf(bus, name));
+  }
+  return ports;
+}
+
+control::FaultInjected FaultManager::Inject(const control::FaultSpec& spec) {
+  if (!spec.label().empty()) {
+    for (const auto& f : faults_)
+      if (Active(f->state) && f->spec.label() == spec.label())
+        throw FaultError("a fault labelled '" + spec.label() + "' is already active");
+  }
+  if (spec.probability() < 0 || spec.probability() > 1) throw FaultError("probability must be within 0..1");
+  auto fault = std::make_unique<Fault>();
+  fault->id = next_id_;
+  fault->spec = spec;
+  fault->started = ctx_.scheduler.Now();
+  Apply(*fault);  // throws before anything is registered
+  if (fault->spec.bus().empty() && !fault->bus.empty()) fault->spec.set_bus(fault->bus);
+  fault->summary = control::SummarizeFault(fault->spec);
+  ++next_id_;
+  Fault& added = *faults_.emplace_back(std::move(fault));
+
+  // A bus-off with automatic recovery is over once the controller has recovered (1408 bit
+  // times): an event, like a restart, not a state to clear.
+  const bool one_shot = spec.kind() == control::RESTART || spec.kind() == control::POWER_CYCLE ||
+                        (spec.kind() == control::BUS_OFF && !spec.manual_recovery());
+  if (one_shot) {
+    added.state = "done";
+    added.ended = added.started;
+  } else if (spec.duration_ms() > 0) {
+    added.expiry = std::make_unique<Timer>(ctx_.scheduler, [this, &added] { End(added, "expired"); });
+    added.expiry->StartAfter(std::chrono::milliseconds(spec.duration_ms()));
+  }
+  spdlog::warn("fault {} injected: {}", added.id, added.summary);
+  if (ctx_.on_event) ctx_.on_event(StatusOf(added), true);
+
+  control::FaultInjected reply;
+  reply.set_fault_id(added.id);
+  reply.set_summary(added.summary);
+  return reply;
+}
+
+FaultManager::Fault& FaultManager::Apply(Fault& fault) {
+  switch (fault.spec.kind()) {
+    case control::BUS_OFF:
+      ApplyBusOff(fault);
+      break;
+    case control::HEARTBEAT_LOSS:
+      ApplyHeartbeatLoss(fault);
+      break;
+    case control::RPDO_TIMEOUT:
+      ApplyRpdoTimeout(fault);
+      break;
+    case control::DROP:
+    case control::DELAY:
+    case control::CORRUPT:
+    case control::DUPLICATE:
+      ApplyFrameFault(fault);
+      break;
+    case control::PARTITION:
+      ApplyPartition(fault);
+      break;
+    case control::BABBLING_IDIOT:
+      ApplyBabblingIdiot(fault);
+      break;
+    case control::ERROR_PASSIVE:
+      ApplyErrorPassive(fault);
+      break;
+    case control::KILL:
+    case control::RESTART:
+    case control::POWER_CYCLE:
+      ApplyProcessFault(fault);
+      break;
+    default:
+      throw FaultError("say which fault (kind)");
+  }
+  return fault;
+}
+
+void FaultManager::ApplyBusOff(Fault& fault) {
+  const FleetNode& node = Node(fault.spec.node());
+  fault.bus = BusFor(fault.spec);
+  (void)node;
+  fault.port = PortOf(fault.bus, fault.spec.node());
+  auto& stage = ctx_.broker.Faults(fault.bus);
+  if (!stage.ForceBusOff(*fault.port, fault.spec.manual_recovery()))
+    throw FaultError("node '" + fault.spec.node() + "' is already bus-off");
+}
+
+void FaultManager::ApplyHeartbeatLoss(Fault& fault) {
+  const FleetNode& node = Node(fault.spec.node());
+  fault.bus = BusFor(fault.spec);
+  const auto node_id = node.node_ids[static_cast<std::size_t>(node.PortOn(fault.bus))];
+  broker::FaultRule rule;
+  rule.source = PortOf(fault.bus, node.name());
+  rule.id = 0x700u + node_id;
+  rule.mask = kStandardMask;
+  rule.extended = false;
+  rule.receivers = ReceiverPorts(fault.bus, fault.spec);
+  rule.action = broker::FaultAction::kDrop;
+  fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
+}
+
+void FaultManager::ApplyRpdoTimeout(Fault& fault) {
+  const FleetNode& node = Node(fault.spec.node());
+  if (!fault.spec.has_cob_id()) throw FaultError("rpdo-timeout needs the PDO's COB-ID (--cob-id)");
+  fault.bus = BusFor(fault.spec);
+  broker::FaultRule rule;
+  rule.id = fault.spec.cob_id();
+  rule.mask = fault.spec.extended() ? kExtendedMask : kStandardMask;
+  rule.extended = fault.spec.extended();
+  rule.receivers = {PortOf(fault.bus, node.name())};
+  rule.action = broker::FaultAction::kDrop;
+  fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
+}
+
+void FaultManager::ApplyFrameFault(Fault& fault) {
+  const auto& spec = fault.spec;
+  fault.bus = BusFor(spec);
+  broker::FaultRule rule;
+  if (!spec.node().empty()) rule.source = PortOf(fault.bus, Node(spec.node()).name());
+  if (spec.has_cob_id()) {
+    rule.id = spec.cob_id();
+    rule.mask = spec.has_mask() ? spec.mask() : (spec.extended() ? kExtendedMask : kStandardMask);
+    rule.extended = spec.extended();
+  }
+  rule.receivers = ReceiverPorts(fault.bus, spec);
+  switch (spec.kind()) {
+    case control::DROP:
+      rule.action = broker::FaultAction::kDrop;
+      break;
+    case control::DELAY:
+      rule.action = broker::FaultAction::kDelay;
+      rule.delay = std::chrono::milliseconds(spec.delay_ms());
+      rule.jitter = std::chrono::milliseconds(spec.jitter_ms());
+      if (spec.delay_ms() == 0 && spec.jitter_ms() == 0)
+        throw FaultError("delay needs --delay and/or --jitter");
+      break;
+    case control::CORRUPT:
+      rule.action = broker::FaultAction::kCorrupt;
+      break;
+    default:
+      rule.action = broker::FaultAction::kDuplicate;
+      break;
+  }
+  rule.probability = spec.probability() > 0 ? spec.probability() : 1.0;
+  rule.seed = spec.seed();
+  if (spec.count() > 0) rule.count = spec.count();
+  try {
+    fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
+  } catch (const std::invalid_argument& e) {
+    throw FaultError(e.what());
+  }
+}
+
+void FaultManager::ApplyPartition(Fault& fault) {
+  const auto& spec = fault.spec;
+  if (spec.groups_size() < 2) throw FaultError("partition needs at least two groups (--group a,b --group c)");
+  fault.bus = BusFor(spec);
+  // Resolve everything first, so a bad name leaves no half-applied partition.
+  std::vector<std::vector<broker::PortId>> groups;
+  for (const auto& group : spec.groups()) {
+    auto& ports = groups.emplace_back();
+    for (const auto& name : group.nodes()) {
+      if (Node(name).PortOn(fault.bus) < 0)
+        throw FaultError("node '" + name + "' is not on bus " + fault.bus);
+      ports.push_back(PortOf(fault.bus, name));
+    }
+  }
+  auto& stage = ctx_.broker.Faults(fault.bus);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    std::vector<broker::PortId> others;
+    for (std::size_t o = 0; o < groups.size(); ++o)
+      if (o != g) others.insert(others.end(), groups[o].begin(), groups[o].end());
+    for (const auto port : groups[g]) {
+      broker::FaultRule rule;
+      rule.source = port;
+      rule.receivers = others;
+      rule.action = broker::FaultAction::kDrop;
+      fault.rules.push_back(stage.Add(rule));
+    }
+  }
+}
+
+void FaultManager::ApplyBabblingIdiot(Fault& fault) {
+  const auto& spec = fault.spec;
+  fault.bus = BusFor(spec);
+  fault.port = PortOf(fault.bus, Node(spec.node()).name());
+  const std::uint32_t id = spec.has_cob_id() ? spec.cob_id() : 0x001;
+  CanFrame frame = CanFrame::Data(id, {0xBA, 0xBB, 0x1E, 0xBA, 0xBB, 0x1E, 0xBA, 0xBB});
+  if (spec.extended()) frame.flags |= CanFrame::kExtended;
+  if (!frame.valid()) throw FaultError("babbling-idiot: identifier out of range");
+  // The node's own controller floods the bus: the frame is offered in every arbitration ahead of
+  // the node's queue, at the bus's full rate, as by a babbling controller.
+  try {
+    ctx_.broker.Faults(fault.bus).StartBabbling(*fault.port, frame);
+    fault.babble_base = ctx_.broker.Port(*fault.port).babble_frames;
+  } catch (const std::invalid_argument& e) {
+    throw FaultError(std::string("babbling-idiot: ") + e.what());
+  }
+}
+
+void FaultManager::ApplyErrorPassive(Fault& fault) {
+  fault.bus = BusFor(fault.spec);
+  fault.port = PortOf(fault.bus, Node(fault.spec.node()).name());
+  ctx_.broker.Faults(fault.bus).HoldErrorPassive(*fault.port, true);
+}
+
+void FaultManager::ApplyProcessFault(Fault& fault) {
+  const FleetNode& node = Node(fault.spec.node());
+  if (node.external() || !ctx_.supervisor.Has(node.name()))
+    throw FaultError("node '" + node.name() + "' runs elsewhere (external): the orchestrator cannot " +
+                     "kill or restart its process");
+  fault.bus = node.buses.front();
+  switch (fault.spec.kind()) {
+    case control::KILL:
+      ctx_.supervisor.Kill(node.name());
+      break;
+    case control::RESTART:
+      ctx_.supervisor.Restart(node.name(), false);
+      break;
+    default:
+      ctx_.supervisor.Restart(node.name(), true);
+      break;
+  }
+}
+
+std::size_t FaultManager::Clear(const control::FaultClear& which) {
+  std::vector<Fault*> targets;
+  for (auto& f : faults_) {
+    if (!Active(f->state)) continue;
+    if (which.fault_id() != 0 ? f->id == which.fault_id()
+                              : (which.label().empty() || f->spec.label() == which.label()))
+      targets.push_back(f.get());
+  }
+  if (targets.empty() && (which.fault_id() != 0 || !which.label().empty())) {
+    throw FaultError(which.fault_id() != 0 ? "no active fault " + std::to_string(which.fault_id())
+                                           : "no active fault labelled '" + which.label() + "'");
+  }
+  for (Fault* f : targets)
+    End(*f, "cleared");
+  return targets.size();
+}
+
+std::uint64_t FaultManager::Hits(const Fault& fault) const {
+  std::uint64_t hits = fault.ended_hits;
+  if (!Active(fault.state)) return hits;
+  if (fault.spec.kind() == control::BABBLING_IDIOT && fault.port) {
+    try {
+      hits += ctx_.broker.Port(*fault.port).babble_frames - fault.babble_base;
+    } catch (const std::invalid_argument&) {
+      // detached: its count went with it
+    }
+  }
+  if (fault.rules.empty()) return hits;
+  const auto live = ctx_.broker.Faults(fault.bus).List();
+  for (const auto rule : fault.rules) {
+    auto it = std::find_if(live.begin(), live.end(), [rule](const auto& r) { return r.id == rule; });
+    // A rule the broker no longer lists was used up: it fired `count` times.
+    hits += it != live.end() ? it->hits : fault.spec.count();
+  }
+  return hits;
+}
+
+void FaultManager::Sweep() {
+  // Count-limited rules end inside the broker; the fault ends with its last rule.
+  for (auto& fault : faults_) {
+    if (!Active(fault->state) || fault->rules.empty() || fault->spec.count() == 0) continue;
+    const auto live = ctx_.broker.Faults(fault->bus).List();
+    const bool any = std::any_of(fault->rules.begin(), fault->rules.end(), [&](broker::RuleId id) {
+      return std::any_of(live.begin(), live.end(), [id](const auto& r) { return r.id == id; });
+    });
+    if (!any) End(*fault, "expired");
+  }
+}
+
+void FaultManager::End(Fault& fault, const char* state) {
+  if (!Active(fault.state)) return;
+  fault.ended_hits = Hits(fault);
+  if (fault.expiry) fault.expiry->Cancel();
+  auto& stage = ctx_.broker.Faults(fault.bus.empty() ? ctx_.broker.Buses().front() : fault.bus);
+  for (const auto rule : fault.rules)
+    stage.Remove(rule);  // false when a count-limited rule already expired
+  fault.rules.clear();
+  try {
+    switch (fault.spec.kind()) {
+      case control::BUS_OFF:
+        // Recovery on command; an automatically recovered port is not bus-off any more.
+        if (fault.port) ctx_.broker.RecoverBusOff(*fault.port);
+        break;
+      case control::ERROR_PASSIVE:
+        if (fault.port) stage.HoldErrorPassive(*fault.port, false);
+        break;
+      case control::BABBLING_IDIOT:
+        if (fault.port) stage.StopBabbling(*fault.port);
+        break;
+      case control::KILL:
+        ctx_.supervisor.Start(fault.spec.node());
+        break;
+      default:
+        break;
+    }
+  } catch (const std::invalid_argument&) {
+    // The port detached meanwhile (the node restarted): nothing left to undo on it.
+  }
+  fault.state = state;
+  fault.ended = ctx_.scheduler.Now();
+  spdlog::warn("fault {} {}: {}", fault.id, state, fault.summary);
+  if (ctx_.on_event) ctx_.on_event(StatusOf(fault), false);
+}
+
+control::FaultStatus FaultManager::StatusOf(const Fault& fault) const {
+  control::FaultStatus status;
+  status.set_fault_id(fault.id);
+  *status.mutable_spec() = fault.spec;
+  status.set_summary(fault.summary);
+  status.set_state(fault.state);
+  status.set_started_s(Seconds(fault.started));
+  status.set_ended_s(Active(fault.state) ? 0.0 : Seconds(fault.ended));
+  status.set_hits(Hits(fault));
+  return status;
+}
+
+std::vector<control::FaultStatus> FaultManager::List(bool include_ended) {
+  Sweep();
+  std::vector<control::FaultStatus> list;
+  for (const auto& f : faults_)
+    if (Active(f->state)) list.push_back(StatusOf(*f));
+  if (include_ended)
+    for (const auto& f : faults_)
+      if (!Active(f->state)) list.push_back(StatusOf(*f));
+  return list;
+}
+
+}  // namespace canfleet::fleet

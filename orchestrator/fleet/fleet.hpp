@@ -1,0 +1,116 @@
+#pragma once
+/// @file The running fleet (`canfleet up`): the orchestrator's side of every node — its process
+/// (Supervisor), what the master sees of it (NodeTracker), its configuration after boot-up, the
+/// faults injected into it — and the control API's answers (ControlHandler).
+///
+/// Threading: everything runs on the event loop's thread, like the Broker it drives.
+
+#include <asio/io_context.hpp>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bus/capture/capture_writer.hpp"
+#include "clock/scheduler.hpp"
+#include "orchestrator/broker/broker.hpp"
+#include "orchestrator/control/control_handler.hpp"
+#include "orchestrator/fleet/fault_manager.hpp"
+#include "orchestrator/fleet/fleet_node.hpp"
+#include "orchestrator/fleet/frame_feed.hpp"
+#include "orchestrator/fleet/master_port.hpp"
+#include "orchestrator/fleet/node_tracker.hpp"
+#include "orchestrator/fleet/sdo_queue.hpp"
+#include "orchestrator/fleet/supervisor.hpp"
+#include "orchestrator/topology/canfleet_topology.pb.h"
+#include "orchestrator/transport/broker_server.hpp"
+
+namespace canfleet::fleet {
+
+struct FleetOptions {
+  topology::Topology topology;  ///< loaded and validated, defaults applied
+  std::filesystem::path node_binary;
+  std::string broker_endpoint;  ///< where started nodes connect ("tcp://127.0.0.1:29600")
+  bool start_processes = true;  ///< false: `canfleet up --no-start`
+};
+
+class Fleet final : public control::ControlHandler {
+ public:
+  Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker, transport::BrokerServer& server,
+        FleetOptions options);
+  ~Fleet() override;
+
+  /// Starts the node processes.
+  void Start();
+  /// Runs once every node has booted (boot-up seen on each of its ports) and been configured.
+  void OnReady(std::function<void()> handler) { on_ready_ = std::move(handler); }
+  /// A control client asked for a shutdown.
+  void OnShutdownRequest(std::function<void()> handler) { on_shutdown_request_ = std::move(handler); }
+  /// Stops every node process (SIGTERM, then SIGKILL after a grace time); `done` runs after.
+  void Stop(std::function<void()> done);
+
+  /// A fault began or ended (the fault event log): for telemetry.
+  void OnFaultEvent(std::function<void(const control::FaultStatus&, bool started)> handler) {
+    on_fault_event_ = std::move(handler);
+  }
+
+  control::Status Status() const;
+
+  // control::ControlHandler
+  void Handle(const control::Request& request, std::shared_ptr<control::Responder> responder) override;
+
+ private:
+  struct PortRuntime {
+    bool configured = false;
+    std::string configuration;  ///< "", "configuring", "configured", or what failed
+  };
+
+  const FleetNode* FindNode(const std::string& name) const;
+  const FleetNode& NodeOrThrow(const std::string& name) const;
+  std::optional<std::uint8_t> NodeIdOn(const std::string& name, const std::string& bus) const;
+  const FleetNode* NodeAt(const std::string& bus, std::uint8_t node_id) const;
+
+  void OnBootUp(const std::string& bus, std::uint8_t node_id);
+  void Configure(const FleetNode& node, std::size_t port);
+  void CheckReady();
+  void StartScenario();
+  void SendNmt(const std::string& bus, std::uint8_t command, std::uint8_t node_id);
+  std::string Nmt(const control::NmtCommand& command);
+
+  // Requests that answer later (SDO, remote I/O) get the responder; the others return a Response.
+  void SdoRead(const control::Request& request, std::shared_ptr<control::Responder> responder);
+  void SdoWrite(const control::SdoWrite& write, std::function<void(std::string error)> done);
+  void IoRequest(const std::string& node, wire::NodeRequest request,
+                 std::function<void(std::string error, control::IoValues values)> done);
+  void StartDump(const control::Request& request, std::shared_ptr<control::Responder> responder);
+  void RunStep(const topology::Step& step);
+
+  double Uptime() const;
+
+  asio::io_context& io_;
+  Scheduler& scheduler_;
+  broker::Broker& broker_;
+  transport::BrokerServer& server_;
+  FleetOptions options_;
+  TimePoint origin_;
+  capture::WallTime wall_origin_;
+
+  std::vector<FleetNode> nodes_;
+  std::map<std::string, std::unique_ptr<MasterPort>> masters_;          ///< by bus
+  std::map<std::string, std::unique_ptr<SdoQueue>> sdo_;                ///< by bus
+  std::map<std::pair<std::string, std::size_t>, PortRuntime> runtime_;  ///< (node, port)
+  NodeTracker tracker_;
+  Supervisor supervisor_;
+  std::unique_ptr<FaultManager> faults_;
+  Captures captures_;
+  std::vector<std::unique_ptr<Timer>> scenario_timers_;
+  bool ready_ = false;
+
+  std::function<void()> on_ready_;
+  std::function<void()> on_shutdown_request_;
+  std::function<void(const control::FaultStatus&, bool)> on_fault_event_;
+};
+
+}  // namespace canfleet::fleet

@@ -1,0 +1,290 @@
+// The control API's answers (Fleet::Handle) and the requests that travel over the bus or the
+// node connection before they can be answered (SDO, simulated I/O).
+#include <spdlog/spdlog.h>
+
+#include <asio/post.hpp>
+
+#include "orchestrator/control/sdo_value.hpp"
+#include "orchestrator/fleet/fleet.hpp"
+
+namespace canfleet::fleet {
+
+namespace {
+
+control::Response Reply(const control::Request& request) {
+  control::Response response;
+  response.set_id(request.id());
+  return response;
+}
+
+control::Response Failed(const control::Request& request, const std::string& error) {
+  control::Response response = Reply(request);
+  response.set_error(error);
+  return response;
+}
+
+control::Response DoneReply(const control::Request& request, const std::string& detail) {
+  control::Response response = Reply(request);
+  response.mutable_done()->set_detail(detail);
+  return response;
+}
+
+/// Dump subscriptions stay alive while their client is connected.
+struct DumpHolder {
+  std::unique_ptr<DumpSubscription> subscription;
+};
+
+}  // namespace
+
+void Fleet::Handle(const control::Request& request, std::shared_ptr<control::Responder> responder) {
+  using R = control::Request;
+  try {
+    switch (request.body_case()) {
+      case R::kStatus: {
+        auto response = Reply(request);
+        *response.mutable_status() = Status();
+        responder->Send(response);
+        return;
+      }
+      case R::kFaultInject: {
+        auto response = Reply(request);
+        *response.mutable_fault_injected() = faults_->Inject(request.fault_inject());
+        responder->Send(response);
+        return;
+      }
+      case R::kFaultClear: {
+        const auto n = faults_->Clear(request.fault_clear());
+        responder->Send(DoneReply(request, "cleared " + std::to_string(n) + (n == 1 ? " fault" : " faults")));
+        return;
+      }
+      case R::kFaultList: {
+        auto response = Reply(request);
+        for (auto& status : faults_->List(request.fault_list().include_ended()))
+          *response.mutable_faults()->add_faults() = std::move(status);
+        responder->Send(response);
+        return;
+      }
+      case R::kIoSet: {
+        NodeOrThrow(request.io_set().node());
+        wire::NodeRequest node_request;
+        node_request.mutable_io_set()->set_name(request.io_set().name());
+        node_request.mutable_io_set()->set_value(request.io_set().value());
+        IoRequest(request.io_set().node(), node_request,
+                  [request, responder](const std::string& error, const control::IoValues&) {
+                    responder->Send(error.empty() ? DoneReply(request, request.io_set().name() + " = " +
+                                                                           request.io_set().value())
+                                                  : Failed(request, error));
+                  });
+        return;
+      }
+      case R::kIoGet: {
+        NodeOrThrow(request.io_get().node());
+        wire::NodeRequest node_request;
+        node_request.mutable_io_get()->set_name(request.io_get().name());
+        IoRequest(request.io_get().node(), node_request,
+                  [request, responder](const std::string& error, const control::IoValues& values) {
+                    if (!error.empty()) return responder->Send(Failed(request, error));
+                    auto response = Reply(request);
+                    *response.mutable_io() = values;
+                    responder->Send(response);
+                  });
+        return;
+      }
+      case R::kSdoRead:
+        SdoRead(request, responder);
+        return;
+      case R::kSdoWrite:
+        SdoWrite(request.sdo_write(), [request, responder](const std::string& error) {
+          responder->Send(error.empty() ? DoneReply(request, "written") : Failed(request, error));
+        });
+        return;
+      case R::kNmt:
+        responder->Send(DoneReply(request, Nmt(request.nmt())));
+        return;
+      case R::kDump:
+        StartDump(request, responder);
+        return;
+      case R::kCaptureStart: {
+        auto response = Reply(request);
+        *response.mutable_capture() = captures_.Start(request.capture_start());
+        spdlog::info("capture {} of {} started: {}", response.capture().capture_id(),
+                     request.capture_start().bus(), response.capture().path());
+        responder->Send(response);
+        return;
+      }
+      case R::kCaptureStop: {
+        const auto line = captures_.Stop(request.capture_stop().capture_id());
+        spdlog::info("{}", line);
+        responder->Send(DoneReply(request, line));
+        return;
+      }
+      case R::kShutdown:
+        responder->Send(DoneReply(request, "shutting down"));
+        if (on_shutdown_request_) asio::post(io_, on_shutdown_request_);
+        return;
+      default:
+        responder->Send(Failed(request, "empty or unknown request"));
+        return;
+    }
+  } catch (const std::exception& e) {
+    responder->Send(Failed(request, e.what()));
+  }
+}
+
+control::Status Fleet::Status() const {
+  control::Status status;
+  status.set_topology(options_.topology.name());
+  status.set_uptime_s(Uptime());
+  std::map<std::pair<std::string, std::string>, broker::PortStats> ports;  // (bus, name)
+  for (const auto& bus : broker_.Buses()) {
+    const auto stats = broker_.Stats(bus, 0);
+    auto* out = status.add_buses();
+    out->set_name(bus);
+    out->set_bitrate(stats.bitrate);
+    out->set_paced(stats.paced);
+    out->set_ports(static_cast<std::uint32_t>(stats.ports));
+    out->set_load_percent(stats.load_percent);
+    out->set_frames_per_s(stats.frames_per_s);
+    out->set_error_frames_per_s(stats.error_frames_per_s);
+    out->set_frames(stats.frames);
+    out->set_error_frames(stats.error_frames);
+    for (auto& port : broker_.Ports(bus))
+      ports[{bus, port.name}] = port;  // the newest attachment of a name wins
+  }
+  for (const auto& node : nodes_) {
+    auto* out = status.add_nodes();
+    out->set_name(node.name());
+    out->set_device(node.device_label);
+    for (std::size_t p = 0; p < node.buses.size(); ++p) {
+      out->add_node_ids(node.node_ids[p]);
+      out->add_buses(node.buses[p]);
+    }
+    if (node.external()) {
+      out->set_process("external");
+    } else {
+      const auto view = supervisor_.View(node.name());
+      out->set_process(view.state);
+      out->set_detail(view.detail);
+      out->set_pid(view.pid);
+      out->set_restarts(view.restarts);
+    }
+    bool attached = true;
+    for (const auto& bus : node.buses)
+      attached = attached && ports.count({bus, node.name()}) != 0;
+    out->set_attached(attached);
+
+    const std::string& bus = node.buses.front();
+    if (auto it = ports.find({bus, node.name()}); it != ports.end()) {
+      const auto& c = it->second.controller;
+      out->set_controller(c.state == ControllerState::kBusOff         ? "bus-off"
+                          : c.state == ControllerState::kErrorPassive ? "error-passive"
+                                                                      : "error-active");
+      out->set_tec(c.tec);
+      out->set_rec(c.rec);
+    }
+    const NodeLiveState* live = tracker_.Find(bus, node.node_ids.front());
+    out->set_booted(live && live->booted);
+    out->set_nmt_state(NmtStateName(live ? live->nmt_state : std::nullopt));
+    out->set_heartbeat_age_s(
+        live && live->last_heartbeat
+            ? std::chrono::duration<double>(scheduler_.Now() - *live->last_heartbeat).count()
+            : -1.0);
+    if (live && live->last_emcy) {
+      auto* emcy = out->mutable_last_emcy();
+      emcy->set_code(live->last_emcy->code);
+      emcy->set_register_(live->last_emcy->error_register);
+      emcy->set_manufacturer(
+          std::string(live->last_emcy->manufacturer.begin(), live->last_emcy->manufacturer.end()));
+      emcy->set_time_s(std::chrono::duration<double>(live->last_emcy->time - origin_).count());
+      out->set_emcy_count(live->emcy_count);
+    }
+    if (out->detail().empty()) {
+      auto rt = runtime_.find({node.name(), 0});
+      if (rt != runtime_.end()) out->set_detail(rt->second.configuration);
+    }
+  }
+  for (auto& fault : faults_->List(false))
+    *status.add_faults() = std::move(fault);
+  return status;
+}
+
+void Fleet::SdoRead(const control::Request& request, std::shared_ptr<control::Responder> responder) {
+  const auto& read = request.sdo_read();
+  const FleetNode& node = NodeOrThrow(read.node());
+  if (read.port() >= node.buses.size())
+    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(read.port()));
+  if (read.index() > 0xFFFF || read.subindex() > 0xFF)
+    throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
+  if (!read.type().empty()) control::RequireSdoType(read.type());  // refuse an unknown type before the bus
+  const auto& bus = node.buses[read.port()];
+  sdo_.at(bus)->Read(
+      node.node_ids[read.port()], static_cast<std::uint16_t>(read.index()),
+      static_cast<std::uint8_t>(read.subindex()), read.block(),
+      [request, responder](canopen::SdoAbort abort, canopen::Bytes data) {
+        if (abort != canopen::SdoAbort::kNone) return responder->Send(Failed(request, DescribeAbort(abort)));
+        auto response = Reply(request);
+        auto* out = response.mutable_sdo();
+        out->set_data(std::string(data.begin(), data.end()));
+        const auto& type = request.sdo_read().type();
+        try {
+          out->set_text(type.empty() ? control::HexBytes(data) : control::FormatSdoValue(type, data));
+        } catch (const std::exception& e) {
+          // The bytes arrived; say why they do not read as the asked type.
+          out->set_text(control::HexBytes(data) + " (" + e.what() + ")");
+        }
+        responder->Send(response);
+      });
+}
+
+void Fleet::SdoWrite(const control::SdoWrite& write, std::function<void(std::string error)> done) {
+  const FleetNode& node = NodeOrThrow(write.node());
+  if (write.port() >= node.buses.size())
+    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(write.port()));
+  if (write.index() > 0xFFFF || write.subindex() > 0xFF)
+    throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
+  auto data = control::EncodeSdoValue(write.type(), write.value());
+  const auto& bus = node.buses[write.port()];
+  sdo_.at(bus)->Write(node.node_ids[write.port()], static_cast<std::uint16_t>(write.index()),
+                      static_cast<std::uint8_t>(write.subindex()), std::move(data), write.block(),
+                      [done](canopen::SdoAbort abort) {
+                        done(abort == canopen::SdoAbort::kNone ? std::string() : DescribeAbort(abort));
+                      });
+}
+
+void Fleet::IoRequest(const std::string& node_name, wire::NodeRequest request,
+                      std::function<void(std::string error, control::IoValues values)> done) {
+  const FleetNode& node = NodeOrThrow(node_name);
+  server_.RequestNode(node.buses.front(), node.name(), std::move(request),
+                      [done, node_name](std::optional<wire::NodeReply> reply) {
+                        control::IoValues values;
+                        values.set_node(node_name);
+                        if (!reply)
+                          return done("node '" + node_name + "' did not answer (is it attached?)", values);
+                        if (!reply->error().empty()) return done(reply->error(), values);
+                        for (const auto& v : reply->values()) {
+                          auto* out = values.add_values();
+                          out->set_name(v.name());
+                          out->set_value(v.value());
+                          out->set_unit(v.unit());
+                          out->set_input(v.input());
+                        }
+                        done({}, values);
+                      });
+}
+
+void Fleet::StartDump(const control::Request& request, std::shared_ptr<control::Responder> responder) {
+  std::vector<std::string> buses;
+  if (request.dump().bus().empty()) {
+    buses = broker_.Buses();
+  } else {
+    buses.push_back(request.dump().bus());
+    broker_.Stats(request.dump().bus(), 0);  // throws for an unknown bus
+  }
+  auto holder = std::make_shared<DumpHolder>();
+  holder->subscription = std::make_unique<DumpSubscription>(broker_, buses, request.dump(), request.id(),
+                                                            responder, wall_origin_);
+  // The subscription lives as long as the client: the responder keeps this closure.
+  responder->OnClose([holder] { holder->subscription.reset(); });
+}
+
+}  // namespace canfleet::fleet

@@ -1,0 +1,63 @@
+#include "orchestrator/fleet/node_tracker.hpp"
+
+namespace canfleet::fleet {
+
+const char* NmtStateName(std::optional<std::uint8_t> state) {
+  if (!state) return "unknown";
+  switch (*state) {
+    case 0x00:
+      return "initialising";
+    case 0x04:
+      return "stopped";
+    case 0x05:
+      return "operational";
+    case 0x7F:
+      return "pre-operational";
+    default:
+      return "unknown";
+  }
+}
+
+void NodeTracker::Observe(const std::string& bus, const CanFrame& frame, TimePoint now) {
+  if (frame.extended() || frame.remote() || frame.error()) return;
+  const std::uint32_t id = frame.id;
+  if (id > 0x700 && id <= 0x77F && frame.dlc == 1) {
+    // CiA 301 §7.2.8.3.2: the state byte's bit 7 is the toggle bit of node guarding replies;
+    // heartbeats and boot-up have it clear.
+    const auto node_id = static_cast<std::uint8_t>(id - 0x700);
+    const auto state = static_cast<std::uint8_t>(frame.data[0] & 0x7F);
+    auto& live = nodes_[{bus, node_id}];
+    live.nmt_state = state;
+    live.last_heartbeat = now;
+    if (state == 0x00) {
+      live.booted = true;
+      if (on_boot_up_) on_boot_up_(bus, node_id);
+    }
+    return;
+  }
+  if (id > 0x080 && id <= 0x0FF && frame.dlc == 8) {
+    const auto node_id = static_cast<std::uint8_t>(id - 0x080);
+    const auto& d = frame.data;
+    SeenEmcy emcy;
+    emcy.code = static_cast<std::uint16_t>(d[0] | (d[1] << 8));
+    emcy.error_register = d[2];
+    for (std::size_t i = 0; i < emcy.manufacturer.size(); ++i)
+      emcy.manufacturer[i] = d[3 + i];
+    emcy.time = now;
+    auto& live = nodes_[{bus, node_id}];
+    live.last_emcy = emcy;
+    ++live.emcy_count;
+    if (on_emcy_) on_emcy_(bus, node_id, emcy);
+  }
+}
+
+const NodeLiveState* NodeTracker::Find(const std::string& bus, std::uint8_t node_id) const {
+  auto it = nodes_.find({bus, node_id});
+  return it == nodes_.end() ? nullptr : &it->second;
+}
+
+void NodeTracker::Forget(const std::string& bus, std::uint8_t node_id) {
+  nodes_.erase({bus, node_id});
+}
+
+}  // namespace canfleet::fleet

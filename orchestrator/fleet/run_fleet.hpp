@@ -1,0 +1,30 @@
+#pragma once
+/// @file `canfleet up`: load a topology, start the orchestrator (broker, node processes, control
+/// API) and run until SIGINT/SIGTERM or a Shutdown request; then stop every node process.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace canfleet::fleet {
+
+struct UpOptions {
+  std::filesystem::path topology;      ///< the topology file
+  std::optional<std::string> control;  ///< overrides Orchestrator.control (e.g. tcp://127.0.0.1:0)
+  std::optional<std::string> listen;   ///< overrides Orchestrator.listen (one broker endpoint)
+  std::filesystem::path node_binary;   ///< canfleet-node; empty: beside this executable, then PATH
+  std::filesystem::path ready_file;    ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
+  std::string log_level = "info";
+  bool no_start = false;         ///< load and start the buses, but no node processes
+  bool telemetry = true;         ///< BusStats and FaultEvents on DDS
+  std::uint32_t dds_domain = 0;  ///< as canfleet-node's --dds-domain (env CANFLEET_DDS_DOMAIN)
+  std::string dds_config;        ///< as --dds-config (env CANFLEET_DDS_CONFIG)
+};
+
+/// Runs the fleet in the calling thread. Returns the process exit code: 0 after a clean
+/// shutdown, 2 when the topology is refused (the message names file, line and field) or an
+/// endpoint cannot be bound.
+int RunFleet(const UpOptions& options);
+
+}  // namespace canfleet::fleet

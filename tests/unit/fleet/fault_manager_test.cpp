@@ -1,0 +1,192 @@
+// FaultManager (orchestrator/fleet/fault_manager): each fault of the control API becomes the
+// right broker rule or controller fault, lives for its duration, and is cleared cleanly. The
+// broker is real (in process, simulated time); its ports are recording sinks named as nodes.
+#include "orchestrator/fleet/fault_manager.hpp"
+
+#include <gtest/gtest.h>
+
+#include <asio/io_context.hpp>
+
+#include "clock/scheduler.hpp"
+#include "tests/support/bus_probe.hpp"
+
+namespace canfleet::fleet {
+namespace {
+
+using namespace std::chrono_literals;
+
+class NullSink final : public broker::PortSink {
+ public:
+  void Deliver(std::span<const broker::TimedFrame> frames) override { received += frames.size(); }
+  void ControllerChanged(const ControllerEvent& event) override { state = event.state; }
+  std::size_t received = 0;
+  ControllerState state = ControllerState::kErrorActive;
+};
+
+class FaultManagerTest : public ::testing::Test {
+ protected:
+  FaultManagerTest() {
+    broker.AddBus({.name = "can0", .bitrate = 250'000});
+    for (const auto& [name, id] : {std::pair{"quad-5", 5}, {"quad-6", 6}, {"quad-7", 7}}) {
+      FleetNode node;
+      node.spec.set_name(name);
+      node.buses = {"can0"};
+      node.node_ids = {static_cast<std::uint8_t>(id)};
+      nodes.push_back(node);
+      ports[name] = broker.Attach("can0", name, sinks[name]);
+    }
+    faults = std::make_unique<FaultManager>(FaultManager::Context{
+        .broker = broker,
+        .scheduler = scheduler,
+        .supervisor = supervisor,
+        .find_node = [this](const std::string& name) -> const FleetNode* {
+          for (const auto& n : nodes)
+            if (n.name() == name) return &n;
+          return nullptr;
+        },
+        .node_names = {"quad-5", "quad-6", "quad-7"},
+        .origin = scheduler.Now(),
+        .on_event = [this](const control::FaultStatus& s,
+                           bool started) { events.push_back((started ? "+" : "-") + s.state()); },
+    });
+  }
+
+  control::FaultSpec Spec(control::FaultKind kind, const std::string& node = "") {
+    control::FaultSpec spec;
+    spec.set_kind(kind);
+    spec.set_node(node);
+    return spec;
+  }
+
+  SimulatedScheduler scheduler;
+  broker::Broker broker{scheduler};
+  asio::io_context io;
+  Supervisor supervisor{io, scheduler, {}};
+  std::vector<FleetNode> nodes;
+  std::map<std::string, NullSink> sinks;
+  std::map<std::string, broker::PortId> ports;
+  std::unique_ptr<FaultManager> faults;
+  std::vector<std::string> events;
+};
+
+TEST_F(FaultManagerTest, HeartbeatLossDropsTheNodesHeartbeatForTheChosenReceivers) {
+  auto spec = Spec(control::HEARTBEAT_LOSS, "quad-5");
+  spec.add_receivers("quad-6");
+  const auto injected = faults->Inject(spec);
+  const auto rules = broker.Faults("can0").List();
+  ASSERT_EQ(rules.size(), 1u);
+  EXPECT_EQ(rules[0].rule.source, ports["quad-5"]);
+  EXPECT_EQ(rules[0].rule.id, 0x705u);
+  EXPECT_EQ(rules[0].rule.mask, 0x7FFu);
+  EXPECT_EQ(rules[0].rule.receivers, std::vector<broker::PortId>{ports["quad-6"]});
+  EXPECT_EQ(rules[0].rule.action, broker::FaultAction::kDrop);
+
+  control::FaultClear clear;
+  clear.set_fault_id(injected.fault_id());
+  EXPECT_EQ(faults->Clear(clear), 1u);
+  EXPECT_TRUE(broker.Faults("can0").List().empty());
+  EXPECT_EQ(events, (std::vector<std::string>{"+active", "-cleared"}));
+  const auto log = faults->List(true);
+  ASSERT_EQ(log.size(), 1u);
+  EXPECT_EQ(log[0].state(), "cleared");
+}
+
+TEST_F(FaultManagerTest, RpdoTimeoutDropsTheCobIdForTheReceivingNodeOnly) {
+  auto spec = Spec(control::RPDO_TIMEOUT, "quad-6");
+  EXPECT_THROW(faults->Inject(spec), FaultError);  // needs the COB-ID
+  spec.set_cob_id(0x185);
+  faults->Inject(spec);
+  const auto rules = broker.Faults("can0").List();
+  ASSERT_EQ(rules.size(), 1u);
+  EXPECT_FALSE(rules[0].rule.source.has_value());
+  EXPECT_EQ(rules[0].rule.id, 0x185u);
+  EXPECT_EQ(rules[0].rule.receivers, std::vector<broker::PortId>{ports["quad-6"]});
+}
+
+TEST_F(FaultManagerTest, DurationExpiresTheFault) {
+  auto spec = Spec(control::DROP, "quad-5");
+  spec.set_duration_ms(500);
+  faults->Inject(spec);
+  scheduler.Advance(499ms);
+  EXPECT_EQ(faults->List(false).size(), 1u);
+  scheduler.Advance(1ms);
+  EXPECT_TRUE(faults->List(false).empty());
+  EXPECT_EQ(faults->List(true).at(0).state(), "expired");
+  EXPECT_TRUE(broker.Faults("can0").List().empty());
+}
+
+TEST_F(FaultManagerTest, PartitionDropsBetweenGroupsOnlyAndHeals) {
+  auto spec = Spec(control::PARTITION);
+  spec.add_groups()->add_nodes("quad-5");
+  auto* second = spec.add_groups();
+  second->add_nodes("quad-6");
+  second->add_nodes("quad-7");
+  faults->Inject(spec);
+  const auto rules = broker.Faults("can0").List();
+  ASSERT_EQ(rules.size(), 3u);  // one per member, towards the other group
+  EXPECT_EQ(rules[0].rule.receivers, (std::vector<broker::PortId>{ports["quad-6"], ports["quad-7"]}));
+  EXPECT_EQ(rules[1].rule.receivers, std::vector<broker::PortId>{ports["quad-5"]});
+  EXPECT_EQ(faults->Clear({}), 1u);
+  EXPECT_TRUE(broker.Faults("can0").List().empty());
+}
+
+TEST_F(FaultManagerTest, BadRequestsAreRefusedWithoutSideEffects) {
+  EXPECT_THROW(faults->Inject(Spec(control::HEARTBEAT_LOSS, "nobody")), FaultError);
+  EXPECT_THROW(faults->Inject(Spec(control::HEARTBEAT_LOSS)), FaultError);
+  EXPECT_THROW(faults->Inject(Spec(control::FAULT_KIND_UNSPECIFIED, "quad-5")), FaultError);
+  auto partition = Spec(control::PARTITION);
+  partition.add_groups()->add_nodes("quad-5");
+  partition.add_groups()->add_nodes("ghost");
+  EXPECT_THROW(faults->Inject(partition), FaultError);
+  EXPECT_THROW(faults->Inject(Spec(control::KILL, "quad-5")), FaultError);  // not supervised here
+  EXPECT_TRUE(broker.Faults("can0").List().empty());
+  EXPECT_TRUE(faults->List(true).empty());
+  control::FaultClear clear;
+  clear.set_fault_id(42);
+  EXPECT_THROW(faults->Clear(clear), FaultError);
+}
+
+TEST_F(FaultManagerTest, LabelsAreUniqueAmongActiveFaults) {
+  auto spec = Spec(control::DROP, "quad-5");
+  spec.set_label("x");
+  faults->Inject(spec);
+  EXPECT_THROW(faults->Inject(spec), FaultError);
+  control::FaultClear clear;
+  clear.set_label("x");
+  EXPECT_EQ(faults->Clear(clear), 1u);
+  faults->Inject(spec);  // free again
+}
+
+TEST_F(FaultManagerTest, BusOffWithManualRecoveryHoldsUntilCleared) {
+  auto spec = Spec(control::BUS_OFF, "quad-5");
+  spec.set_manual_recovery(true);
+  faults->Inject(spec);
+  scheduler.Advance(100ms);  // far beyond 1408 bit times at 250 kbit/s
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kBusOff);
+  faults->Clear({});
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kErrorActive);
+}
+
+TEST_F(FaultManagerTest, ErrorPassiveIsHeldAndReleased) {
+  faults->Inject(Spec(control::ERROR_PASSIVE, "quad-5"));
+  scheduler.Advance(10ms);
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kErrorPassive);
+  faults->Clear({});
+  scheduler.Advance(10ms);
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kErrorActive);
+}
+
+TEST_F(FaultManagerTest, BabblingIdiotKeepsTheNodesQueueFull) {
+  auto spec = Spec(control::BABBLING_IDIOT, "quad-5");
+  faults->Inject(spec);
+  scheduler.Advance(100ms);
+  const auto stats = broker.Stats("can0");
+  EXPECT_GT(stats.load_percent, 90.0);
+  EXPECT_GT(sinks["quad-6"].received, 100u);
+  faults->Clear({});
+  const auto hits = faults->List(true).at(0).hits();
+  EXPECT_GT(hits, 100u);
+}
+
+}  // namespace
+}  // namespace canfleet::fleet
