@@ -30,7 +30,8 @@ stop() {
   wait "$up" 2>/dev/null || true
   echo "demo stopped; the orchestrator's log is build/demo/orchestrator.log"
 }
-trap stop EXIT INT TERM
+trap stop EXIT
+trap 'exit 130' INT TERM
 
 echo "starting the fleet of $topology (log: build/demo/orchestrator.log) ..."
 for _ in $(seq 1 600); do

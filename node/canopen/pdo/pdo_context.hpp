@@ -3,12 +3,15 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <optional>
+#include <span>
 
 #include "bus/bus_port.hpp"
 #include "clock/scheduler.hpp"
 #include "node/canopen/common/comm_error.hpp"
 #include "node/canopen/od/object_dictionary.hpp"
+#include "node/canopen/pdo/pdo_mapping.hpp"
 
 namespace canfleet::canopen {
 
@@ -29,6 +32,9 @@ struct PdoContext {
   PdoCounters& counters;
   const SubObject* window = nullptr;  ///< 1007h synchronous window length, µs; may be null
   std::optional<TimePoint> last_sync;
+  /// Device veto on a TPDO about to be sent (PdoService::SetTpdoGate): false = not sent. Empty:
+  /// every TPDO is sent.
+  std::function<bool(std::size_t tpdo_number, std::span<const MappedObject> entries)> tpdo_gate;
 
   /// CiA 301 §7.5.2.7: true within 1007h µs (inclusive) after the last SYNC, always when 1007h is
   /// 0 or absent, never before the first SYNC when a window is set.

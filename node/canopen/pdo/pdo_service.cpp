@@ -7,7 +7,7 @@ constexpr std::uint16_t kSyncWindowLengthIndex = 0x1007;
 }  // namespace
 
 PdoService::PdoService(ObjectDictionary& od, BusPort& port, Scheduler& scheduler, CommErrorSink& errors)
-    : ctx_{od, port, scheduler, errors, counters_, od.Find(kSyncWindowLengthIndex, 0), std::nullopt} {
+    : ctx_{od, port, scheduler, errors, counters_, od.Find(kSyncWindowLengthIndex, 0), std::nullopt, {}} {
   const auto last = static_cast<std::uint16_t>(kRpdoCommBase + kMaxPdos - 1);
   for (auto it = od.objects().lower_bound(kRpdoCommBase); it != od.objects().end() && it->first <= last;
        ++it) {

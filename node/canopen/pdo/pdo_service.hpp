@@ -64,6 +64,13 @@ class PdoService {
   /// Device/application event for TPDO `tpdo_number` (1-based); ignored if there is none.
   void RequestTpdo(std::size_t tpdo_number);
 
+  /// Device hook: asked before every TPDO transmission with its number (1-based) and mapping;
+  /// returning false keeps the frame off the bus (e.g. a manual that sends no CAN message for a
+  /// disabled channel). One gate; a new one replaces it.
+  void SetTpdoGate(std::function<bool(std::size_t tpdo_number, std::span<const MappedObject> entries)> gate) {
+    ctx_.tpdo_gate = std::move(gate);
+  }
+
   const PdoCounters& Counters() const { return counters_; }
   /// Number of RPDOs/TPDOs found in the dictionary.
   std::size_t RpdoCount() const { return rpdos_.size(); }

@@ -127,6 +127,13 @@ void Tpdo::TransmitCurrent() {
 
 void Tpdo::Transmit(const std::array<std::uint8_t, 8>& data) {
   const auto& comm = config_.comm();
+  if (ctx_.tpdo_gate && !ctx_.tpdo_gate(number_, config_.mapping().Entries())) {
+    // Vetoed by the device: nothing on the bus, but the timers run on as if it had been sent, so
+    // the PDO resumes on its own period once the device lets it through.
+    event_pending_ = false;
+    if (IsEventDriven(comm.type) && comm.event_timer.count() > 0) event_timer_.StartAfter(comm.event_timer);
+    return;
+  }
   CanFrame frame;
   frame.id = comm.cob_id.can_id;
   frame.flags = comm.cob_id.extended ? CanFrame::kExtended : 0;

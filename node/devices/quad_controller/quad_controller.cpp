@@ -42,6 +42,22 @@ void QuadController::Attach(DeviceContext& context) {
          {quad::kDoWriteState, quad::kAoFieldValue, quad::kReceivedPv, quad::kReceivedPvStatus})
       store->Exclude(index);
   }
+  // Appendix A, Table 1.0: for a disabled input "no CAN messages associated with that channel are
+  // sent". A TPDO that carries only disabled channels' values (7100h/7130h) stays off the bus; one
+  // that also carries anything else is sent (0 in the disabled channel's bytes, README choice 16).
+  stack_->pdo().SetTpdoGate([this](std::size_t, std::span<const canopen::MappedObject> entries) {
+    if (entries.empty()) return true;
+    for (const auto& entry : entries) {
+      const bool input_value =
+          entry.sub->index == quad::kAiFieldValue || entry.sub->index == quad::kAiProcessValue;
+      if (!input_value) return true;
+      const auto* mode = stack_->od().Find(quad::kAiOperatingMode, entry.sub->sub_index);
+      if (!mode ||
+          canopen::DecodeUnsignedLe(mode->value) != static_cast<std::uint8_t>(quad::OperatingMode::kDisabled))
+        return true;
+    }
+    return false;
+  });
   // Armed in this order, the 10 ms sample runs before the 1 ms output tick due at the same time.
   sample_tick_ = std::make_unique<PeriodicTick>(context.scheduler, kSamplePeriod, [this] { OnSample(); });
   output_tick_ = std::make_unique<PeriodicTick>(context.scheduler, kOutputPeriod, [this] { OnOutputTick(); });

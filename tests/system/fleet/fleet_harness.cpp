@@ -1,6 +1,7 @@
 #include "tests/system/fleet/fleet_harness.hpp"
 
 #include <google/protobuf/util/json_util.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -73,8 +74,10 @@ FleetUnderTest::~FleetUnderTest() {
   up_->Signal(SIGTERM);
   up_->Wait(std::chrono::seconds(30));
   // No orphans: every node process the orchestrator reported is gone.
-  for (const int pid : pids)
-    WaitUntil([pid] { return ::kill(pid, 0) != 0; }, std::chrono::seconds(10));
+  for (const int pid : pids) {
+    if (!WaitUntil([pid] { return ::kill(pid, 0) != 0; }, std::chrono::seconds(10)))
+      ADD_FAILURE() << "node process " << pid << " outlived its orchestrator";
+  }
 }
 
 bool FleetUnderTest::WaitReady(std::chrono::milliseconds timeout) {

@@ -197,5 +197,87 @@ TEST(FleetFrames, DumpAndCaptureShowTheBusTraffic) {
   EXPECT_EQ(static_cast<unsigned char>(bytes[20]), 227u);  // LINKTYPE_CAN_SOCKETCAN
 }
 
+// A node started elsewhere (another host, a container) attaches by name: the orchestrator
+// configures it after its boot-up like its own, and reaches its simulated I/O over its broker
+// connection.
+TEST(FleetSupervision, ExternalNodeAttachesByNameAndIsConfigured) {
+  FleetUnderTest fleet(R"(
+name: "fleet-test"
+bus { name: "can0" bitrate: 500000 }
+node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" }
+node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" external: true
+       heartbeat { producer_ms: 300 } }
+)");
+  std::string broker;
+  ASSERT_TRUE(WaitUntil(
+      [&] {
+        std::ifstream in(fleet.dir().File("ready"));
+        std::string key, value;
+        while (in >> key >> value)
+          if (key == "broker") broker = value;
+        return !broker.empty();
+      },
+      kLong));
+  const auto before = fleet.Status();
+  EXPECT_EQ(fleet.Node(before, "remote-8")->process(), "external");
+  EXPECT_FALSE(fleet.Node(before, "remote-8")->attached());
+
+  ChildProcess remote({PROGRAM_CANFLEET_NODE, "--device", "quad-controller", "--node-id", "8", "--name",
+                       "remote-8", "--bus", "can0@" + broker, "--no-telemetry"},
+                      fleet.dir().File("remote-8.log"));
+  ASSERT_TRUE(fleet.WaitReady()) << fleet.Log();
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        const auto status = fleet.Status();
+        const auto* n = fleet.Node(status, "remote-8");
+        return n->attached() && n->booted() && n->nmt_state() == "operational";
+      },
+      kLong))
+      << fleet.Log();
+  EXPECT_EQ(fleet.SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 300u);  // configured by the orchestrator
+  ASSERT_EQ(fleet.Cli({"io", "set", "remote-8", "AIN1.voltage_mV", "2500"}).exit_code, 0);
+  EXPECT_EQ(fleet.IoGet("remote-8", "AIN1.voltage_mV"), "2500");
+  // Its process is not ours to kill.
+  EXPECT_EQ(fleet.Cli({"fault", "inject", "kill", "--node", "remote-8"}).exit_code, 1);
+}
+
+// The topology's scenario runs on its own once the fleet is ready: inject, then clear by label.
+TEST(FleetScenario, StepsInjectAndClearFaultsOnTime) {
+  FleetUnderTest fleet(R"(
+name: "fleet-test"
+bus { name: "can0" bitrate: 250000 }
+node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" heartbeat { producer_ms: 200 } }
+node { name: "quad-6" device: "quad-controller" node_id: 6 bus: "can0"
+       heartbeat { producer_ms: 200 consumer { node: "quad-5" timeout_ms: 1000 } } }
+scenario { at_ms: 1000 inject { kind: HEARTBEAT_LOSS node: "quad-5" label: "hb" } }
+scenario { at_ms: 4000 clear { label: "hb" } }
+scenario { at_ms: 5000 nmt { action: NMT_START node: "quad-6" } }
+)");
+  ASSERT_TRUE(fleet.WaitReady()) << fleet.Log();
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        const auto status = fleet.Status();
+        return fleet.Node(status, "quad-6")->last_emcy().code() == 0x8130;
+      },
+      kLong))
+      << fleet.Log();
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        control::FaultList list;
+        ParseJson(fleet.Cli({"fault", "list", "--all", "--json"}).out, list);
+        return list.faults_size() == 1 && list.faults(0).state() == "cleared" &&
+               list.faults(0).spec().label() == "hb";
+      },
+      kLong));
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        const auto status = fleet.Status();
+        return fleet.Node(status, "quad-6")->nmt_state() == "operational" &&
+               fleet.Node(status, "quad-6")->last_emcy().code() == 0x0000;
+      },
+      kLong))
+      << fleet.Log();
+}
+
 }  // namespace
 }  // namespace canfleet::system_test

@@ -186,6 +186,20 @@ TEST_F(QuadAiTest, ADisabledInputSendsNothingOfItsOwn) {
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0xFF01, 0x01, 2, 0x01)});
 }
 
+// Appendix A, Table 1.0: a TPDO that carries only disabled channels (TPDO1 maps 7100h.1-4) is
+// not sent at all; enabling one channel brings it back on its event timer (README choice 16).
+TEST_F(QuadAiTest, ATpdoOfOnlyDisabledInputsIsNotSent) {
+  for (std::uint8_t n = 1; n <= 4; ++n)
+    Write(0x6112, n, 0, 1);
+  Start();
+  Advance(299ms);
+  EXPECT_TRUE(Frames("185#").empty());
+  Write(0x6112, 3, 1, 1);  // AIN3 in use again
+  SetNumber("AIN3.voltage_mV", 3000);
+  Advance(200ms);
+  EXPECT_FALSE(Frames("185#").empty());
+}
+
 // §3.3.13, §3.3.14: a value not listed → SDO abort, previous value unchanged.
 TEST_F(QuadAiTest, InvalidSensorTypeOrModeIsRefusedAndTheOldValueKept) {
   EXPECT_EQ(TryWrite(0x6110, 1, 41, 2), SdoAborted(0x6110, 1, 0x06090030));
