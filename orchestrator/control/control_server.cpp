@@ -5,6 +5,7 @@
 #include <asio/steady_timer.hpp>
 #include <stdexcept>
 
+#include "bus/wire/tcp_endpoint_text.hpp"
 #include "orchestrator/control/control_session.hpp"
 
 namespace canfleet::control {
@@ -14,11 +15,6 @@ namespace {
 /// After a failed accept (e.g. out of file descriptors), wait this long before the next one
 /// instead of spinning.
 constexpr std::chrono::milliseconds kAcceptRetry{100};
-
-std::string Describe(const asio::ip::tcp::endpoint& ep) {
-  return ep.address().is_v6() ? "[" + ep.address().to_string() + "]:" + std::to_string(ep.port())
-                              : ep.address().to_string() + ":" + std::to_string(ep.port());
-}
 
 }  // namespace
 
@@ -43,9 +39,9 @@ asio::ip::tcp::endpoint ControlServer::Listen(const std::string& endpoint) {
     spdlog::warn(
         "control API listening on tcp://{}, which other hosts can reach: anyone who can connect "
         "can drive the fleet",
-        Describe(bound));
+        wire::TcpEndpointText(bound));
   else
-    spdlog::debug("control API listening on tcp://{}", Describe(bound));
+    spdlog::debug("control API listening on tcp://{}", wire::TcpEndpointText(bound));
   acceptors_.push_back(std::move(acceptor));
   endpoints_.push_back(bound);
   Accept(acceptors_.size() - 1);
@@ -69,7 +65,7 @@ void ControlServer::Accept(std::size_t index) {
     socket.set_option(asio::ip::tcp::no_delay(true), ignored);
     std::string peer = "tcp";
     const auto remote = socket.remote_endpoint(ignored);
-    if (!ignored) peer = Describe(remote);
+    if (!ignored) peer = wire::TcpEndpointText(remote);
     stats_->accepted++;
     const std::string label = "control session " + std::to_string(next_session_++) + " (" + peer + ")";
     auto session =

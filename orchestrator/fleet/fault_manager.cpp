@@ -126,7 +126,7 @@ control::FaultInjected FaultManager::Inject(const control::FaultSpec& spec) {
   return reply;
 }
 
-FaultManager::Fault& FaultManager::Apply(Fault& fault) {
+void FaultManager::Apply(Fault& fault) {
   switch (fault.spec.kind()) {
     case control::BUS_OFF:
       ApplyBusOff(fault);
@@ -160,14 +160,11 @@ FaultManager::Fault& FaultManager::Apply(Fault& fault) {
     default:
       throw FaultError("say which fault (kind)");
   }
-  return fault;
 }
 
 void FaultManager::ApplyBusOff(Fault& fault) {
-  const FleetNode& node = Node(fault.spec.node());
   fault.bus = BusFor(fault.spec);
-  (void)node;
-  fault.port = PortOf(fault.bus, fault.spec.node());
+  fault.port = PortOf(fault.bus, Node(fault.spec.node()).name());
   auto& stage = ctx_.broker.Faults(fault.bus);
   if (!stage.ForceBusOff(*fault.port, fault.spec.manual_recovery()))
     throw FaultError("node '" + fault.spec.node() + "' is already bus-off");

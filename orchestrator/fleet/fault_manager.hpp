@@ -33,8 +33,7 @@ class FaultManager {
     Scheduler& scheduler;
     Supervisor& supervisor;
     std::function<const FleetNode*(const std::string&)> find_node;
-    std::vector<std::string> node_names;  ///< every node, for receivers "all"
-    TimePoint origin{};                   ///< uptime 0
+    TimePoint origin{};  ///< uptime 0
     /// A fault began (`started`) or ended; for the log and telemetry.
     std::function<void(const control::FaultStatus&, bool started)> on_event;
   };
@@ -58,7 +57,7 @@ class FaultManager {
  private:
   struct Fault;
 
-  Fault& Apply(Fault& fault);
+  void Apply(Fault& fault);
   void ApplyBusOff(Fault& fault);
   void ApplyHeartbeatLoss(Fault& fault);
   void ApplyRpdoTimeout(Fault& fault);

@@ -100,15 +100,11 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
                  emcy.manufacturer[4]);
   });
 
-  std::vector<std::string> names;
-  for (const auto& node : nodes_)
-    names.push_back(node.name());
   faults_ = std::make_unique<FaultManager>(FaultManager::Context{
       .broker = broker_,
       .scheduler = scheduler_,
       .supervisor = supervisor_,
       .find_node = [this](const std::string& name) { return FindNode(name); },
-      .node_names = names,
       .origin = origin_,
       .on_event =
           [this](const control::FaultStatus& status, bool started) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "bus/wire/tcp_endpoint_text.hpp"
 #include "clock/asio_scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/broker_telemetry/broker_telemetry.hpp"
@@ -115,7 +116,7 @@ int RunFleet(const UpOptions& options) {
     fleet = std::make_unique<Fleet>(io, scheduler, broker, server, std::move(fleet_options));
     control_server = std::make_unique<control::ControlServer>(io, *fleet);
     const auto bound = control_server->Listen(spec.orchestrator().control());
-    control_endpoint = "tcp://" + bound.address().to_string() + ":" + std::to_string(bound.port());
+    control_endpoint = "tcp://" + wire::TcpEndpointText(bound);
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -9,6 +9,7 @@
 #include <asio/steady_timer.hpp>
 #include <stdexcept>
 
+#include "bus/wire/tcp_endpoint_text.hpp"
 #include "orchestrator/transport/session.hpp"
 #include "orchestrator/transport/unix_socket_path.hpp"
 
@@ -19,11 +20,6 @@ namespace {
 /// After a failed accept (e.g. out of file descriptors), wait this long before the next one
 /// instead of spinning.
 constexpr std::chrono::milliseconds kAcceptRetry{100};
-
-std::string Describe(const asio::ip::tcp::endpoint& ep) {
-  return ep.address().is_v6() ? "[" + ep.address().to_string() + "]:" + std::to_string(ep.port())
-                              : ep.address().to_string() + ":" + std::to_string(ep.port());
-}
 
 }  // namespace
 
@@ -73,7 +69,7 @@ void BrokerServer::AcceptTcp(std::size_t index) {
       asio::error_code ignored;
       socket.set_option(asio::ip::tcp::no_delay(true), ignored);  // batches are whole when written
       const auto remote = socket.remote_endpoint(ignored);
-      if (!ignored) peer = "tcp " + Describe(remote);
+      if (!ignored) peer = "tcp " + wire::TcpEndpointText(remote);
       const auto protocol = socket.local_endpoint(ignored).protocol();
       generic = asio::generic::stream_protocol::socket(
           io_, asio::generic::stream_protocol(protocol.family(), protocol.protocol()), socket.release());

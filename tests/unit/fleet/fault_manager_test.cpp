@@ -44,7 +44,6 @@ class FaultManagerTest : public ::testing::Test {
             if (n.name() == name) return &n;
           return nullptr;
         },
-        .node_names = {"quad-5", "quad-6", "quad-7"},
         .origin = scheduler.Now(),
         .on_event = [this](const control::FaultStatus& s,
                            bool started) { events.push_back((started ? "+" : "-") + s.state()); },
