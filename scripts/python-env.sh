@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Creates the project's Python virtualenv (.venv) with pinned python-can and canopen from PyPI,
-# used by the socketcand system test (python-can's `socketcand` interface) and the conformance
-# suite (python-canopen as an independent CANopen master). Idempotent: when the pinned versions
+# Creates the project's Python virtualenv (.venv) with pinned python-can, canopen and pytest from
+# PyPI, used by the socketcand system test (python-can's `socketcand` interface) and the
+# conformance suite (tests/conformance/: python-canopen as an independent CANopen master, run by
+# pytest). Idempotent: when the pinned versions
 # are installed it does nothing and needs no network.
 #
 # Usage: scripts/python-env.sh          prints the interpreter path (.venv/bin/python)
@@ -18,6 +19,7 @@ cd "$(dirname "$0")/.."
 
 PYTHON_CAN_VERSION=4.6.1
 CANOPEN_VERSION=2.4.1
+PYTEST_VERSION=8.3.5
 base_python=/usr/bin/python3
 venv=.venv
 
@@ -31,11 +33,12 @@ exec 9>"$venv/.lock"  # several test processes may ask at once
 flock 9
 
 installed() {
-  [ -x "$venv/bin/python" ] && "$venv/bin/python" - "$PYTHON_CAN_VERSION" "$CANOPEN_VERSION" <<'PY' 2>/dev/null
+  [ -x "$venv/bin/python" ] && "$venv/bin/python" - "$PYTHON_CAN_VERSION" "$CANOPEN_VERSION" "$PYTEST_VERSION" <<'PY' 2>/dev/null
 import sys
 from importlib.metadata import version, PackageNotFoundError
 try:
-    ok = version("python-can") == sys.argv[1] and version("canopen") == sys.argv[2]
+    ok = (version("python-can") == sys.argv[1] and version("canopen") == sys.argv[2]
+          and version("pytest") == sys.argv[3])
 except PackageNotFoundError:
     ok = False
 sys.exit(0 if ok else 1)
@@ -46,9 +49,10 @@ if ! installed; then
   if [ ! -x "$venv/bin/python" ]; then
     "$base_python" -m venv "$venv" >&2
   fi
-  echo "python-env: installing python-can==$PYTHON_CAN_VERSION canopen==$CANOPEN_VERSION into $venv" >&2
+  echo "python-env: installing python-can==$PYTHON_CAN_VERSION canopen==$CANOPEN_VERSION" \
+    "pytest==$PYTEST_VERSION into $venv" >&2
   "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
-    "python-can==$PYTHON_CAN_VERSION" "canopen==$CANOPEN_VERSION" >&2
+    "python-can==$PYTHON_CAN_VERSION" "canopen==$CANOPEN_VERSION" "pytest==$PYTEST_VERSION" >&2
   installed || {
     echo "python-env: the pinned versions are not importable after installing" >&2
     exit 1

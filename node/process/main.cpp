@@ -40,7 +40,7 @@ std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spe
   client.endpoint = spec.endpoint;
   client.bus = spec.bus;
   client.node_name = options.name;
-  client.node_id = node_id;
+  client.node_id = node::BrokerHelloNodeId(node_id);
   auto port = std::make_unique<BrokerClientPort>(io, client);
   port->OnConnection(
       [log, started = false, on_first_connect](bool connected, const std::string& detail) mutable {

@@ -33,4 +33,10 @@ struct NodeOptions {
 /// @throws std::invalid_argument naming the option and the problem.
 BusSpec ParseBusSpec(const std::string& text);
 
+/// The node-ID a port announces to the broker: the broker's hello takes 1..127, or 0 for "none".
+/// An unconfigured LSS slave (--node-id 255, CiA 305 §8.2) has none until a master assigns one.
+constexpr std::uint32_t BrokerHelloNodeId(std::uint8_t node_id) {
+  return node_id >= 1 && node_id <= 127 ? node_id : 0;
+}
+
 }  // namespace canfleet::node

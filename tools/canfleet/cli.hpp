@@ -55,6 +55,7 @@ void AddSdoCommands(CLI::App& app, Cli& cli);
 void AddNmtCommands(CLI::App& app, Cli& cli);
 void AddDumpCommand(CLI::App& app, Cli& cli);
 void AddCaptureCommands(CLI::App& app, Cli& cli);
+void AddTelemetryCommands(CLI::App& app, Cli& cli);  ///< top, watch (DDS, not the control API)
 
 /// Sends `request` to the orchestrator and returns its response. Throws CommandError when it
 /// cannot be reached or answers with an error.

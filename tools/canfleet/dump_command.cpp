@@ -15,7 +15,7 @@ namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
 
-extern "C" void OnStopSignal(int) {
+extern "C" void OnDumpStopSignal(int) {
   g_stop = 1;
 }
 
@@ -23,7 +23,7 @@ extern "C" void OnStopSignal(int) {
 /// (dump | head) shows as a failed write instead of killing us with SIGPIPE.
 void InstallSignalHandlers() {
   struct sigaction action {};
-  action.sa_handler = OnStopSignal;
+  action.sa_handler = OnDumpStopSignal;
   sigemptyset(&action.sa_mask);
   action.sa_flags = 0;
   sigaction(SIGINT, &action, nullptr);

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   AddNmtCommands(app, cli);
   AddDumpCommand(app, cli);
   AddCaptureCommands(app, cli);
+  AddTelemetryCommands(app, cli);
 
   try {
     app.parse(argc, argv);

@@ -20,7 +20,7 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
-extern "C" void OnStopSignal(int) {
+extern "C" void OnTopStopSignal(int) {
   g_stop = true;
 }
 
@@ -212,8 +212,8 @@ int RunTop(const TopOptions& options) {
   update_size();
 
   g_stop = false;
-  auto* previous_int = std::signal(SIGINT, OnStopSignal);
-  auto* previous_term = std::signal(SIGTERM, OnStopSignal);
+  auto* previous_int = std::signal(SIGINT, OnTopStopSignal);
+  auto* previous_term = std::signal(SIGTERM, OnTopStopSignal);
   struct RestoreSignals {
     decltype(previous_int) i, t;
     ~RestoreSignals() {

@@ -1,4 +1,4 @@
-// canfleet-top: standalone `canfleet top` until the canfleet CLI calls RunTop() itself.
+// canfleet-top: `canfleet top` as a program of its own (links DDS only: small, for containers next to a fleet).
 #include <CLI/CLI.hpp>
 
 #include <iostream>

@@ -16,7 +16,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 std::atomic<telemetry::FleetReader*> g_reader{nullptr};
 
-extern "C" void OnSignal(int) {
+extern "C" void OnWatchStopSignal(int) {
   g_stop = true;
   if (auto* reader = g_reader.load()) reader->Wake();  // dds_waitset_set_trigger, as pong.c does
 }
@@ -71,8 +71,8 @@ int RunWatch(const WatchOptions& options) {
 
   g_stop = false;
   g_reader = &reader;
-  auto* previous_int = std::signal(SIGINT, OnSignal);
-  auto* previous_term = std::signal(SIGTERM, OnSignal);
+  auto* previous_int = std::signal(SIGINT, OnWatchStopSignal);
+  auto* previous_term = std::signal(SIGTERM, OnWatchStopSignal);
   int printed = 0;
   int result = -1;
   while (result < 0) {

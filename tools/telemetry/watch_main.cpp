@@ -1,4 +1,4 @@
-// canfleet-watch: standalone `canfleet watch` until the canfleet CLI calls RunWatch() itself.
+// canfleet-watch: `canfleet watch` as a program of its own (links DDS only: small, for containers next to a fleet).
 #include <CLI/CLI.hpp>
 
 #include <iostream>

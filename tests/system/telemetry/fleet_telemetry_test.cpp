@@ -15,8 +15,8 @@
 #include <mutex>
 #include <sstream>
 
-#include "telemetry/fleet_reader.hpp"
 #include "tests/system/support/child_process.hpp"
+#include "tests/system/telemetry/dds_monitor.hpp"
 #include "tools/telemetry/fleet_view.hpp"
 
 namespace canfleet::system_test {
@@ -35,43 +35,6 @@ std::vector<std::string> DdsArgs(std::uint32_t domain) {
   return {"--dds-domain", std::to_string(domain), "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG};
 }
 
-/// A test-side monitor: a participant, a FleetReader and the model tools use.
-class Monitor {
- public:
-  explicit Monitor(std::uint32_t domain)
-      : participant_({.domain_id = domain, .config_file = CANFLEET_DDS_LOOPBACK_CONFIG}),
-        view_(std::chrono::system_clock::now()),
-        reader_(participant_,
-                {.node_status = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
-                 .emcy = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
-                 .io = {},
-                 .bus_stats = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
-                 .fault = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); }}) {}
-
-  bool Until(const std::function<bool()>& condition, std::chrono::milliseconds timeout = kPatience) {
-    return WaitUntil(
-        [&] {
-          reader_.Poll();
-          return condition();
-        },
-        timeout);
-  }
-  const FleetView& view() const { return view_; }
-  const std::vector<FleetEvent>& events() const { return events_; }
-  bool Has(const std::function<bool(const FleetEvent&)>& match) const {
-    return std::any_of(events_.begin(), events_.end(), match);
-  }
-  const tools::NodeRow* Node(const std::string& bus, std::uint8_t id) const {
-    const auto it = view_.nodes().find({bus, id});
-    return it == view_.nodes().end() ? nullptr : &it->second;
-  }
-
- private:
-  telemetry::Participant participant_;
-  FleetView view_;
-  std::vector<FleetEvent> events_;
-  telemetry::FleetReader reader_;
-};
 
 class FleetTelemetry : public ::testing::Test {
  protected:
@@ -106,8 +69,10 @@ class FleetTelemetry : public ::testing::Test {
     ASSERT_TRUE(process.WaitForPrefix("ok " + line)) << process.Log();
   }
 
-  std::string RunTool(const std::string& program, std::vector<std::string> args, const std::string& name) {
-    std::vector<std::string> argv = {program};
+  /// Runs `command` (a program, or `canfleet` and its subcommand) with the DDS options and `args`.
+  std::string RunTool(std::vector<std::string> command, std::vector<std::string> args,
+                      const std::string& name) {
+    std::vector<std::string> argv = std::move(command);
     for (auto& a : DdsArgs(kDomain))
       argv.push_back(a);
     for (auto& a : args)
@@ -128,7 +93,7 @@ class FleetTelemetry : public ::testing::Test {
 };
 
 TEST_F(FleetTelemetry, ReaderSeesEveryNodeTheFaultAndTheRecoveryAndLateJoinersSeeTheFleet) {
-  Monitor monitor(kDomain);
+  Monitor monitor(kDomain, CANFLEET_DDS_LOOPBACK_CONFIG);
   StartFleet();
   // Given 20 node processes: every node's status reaches the reader.
   ASSERT_TRUE(monitor.Until([&] { return monitor.view().nodes().size() == kNodes; }, kFleetPatience))
@@ -171,8 +136,8 @@ TEST_F(FleetTelemetry, ReaderSeesEveryNodeTheFaultAndTheRecoveryAndLateJoinersSe
   EXPECT_TRUE(monitor.view().buses().at("sys0").active_faults.empty());
 
   // A late joiner: canfleet-top, started now, prints every node's current status at once.
-  const std::string top =
-      RunTool(PROGRAM_CANFLEET_TOP, {"--once", "--height", "60", "--color", "never", "--wait", "30"}, "top");
+  const std::string top = RunTool({PROGRAM_CANFLEET, "top"},
+                                  {"--once", "--height", "60", "--color", "never", "--wait", "30"}, "top");
   int rows = 0;
   std::istringstream lines(top);
   for (std::string line; std::getline(lines, line);) {
@@ -183,7 +148,7 @@ TEST_F(FleetTelemetry, ReaderSeesEveryNodeTheFaultAndTheRecoveryAndLateJoinersSe
 
   // A late canfleet-watch gets the fault history (transient-local events) as JSON lines.
   const std::string watch = RunTool(
-      PROGRAM_CANFLEET_WATCH, {"--json", "--type", "fault", "--count", "2", "--timeout", "30"}, "watch");
+      {PROGRAM_CANFLEET, "watch"}, {"--json", "--type", "fault", "--count", "2", "--timeout", "30"}, "watch");
   EXPECT_NE(watch.find(R"("type":"fault","bus":"sys0","node":7,"fault_id":1,"action":"injected")"),
             std::string::npos)
       << watch;
