@@ -1,11 +1,14 @@
 #include "clock/asio_scheduler.hpp"
 
+#include <asio/post.hpp>
+
 namespace canfleet {
 
 AsioScheduler::AsioScheduler(asio::io_context& io)
     : os_timer_(io), epoch_(std::chrono::steady_clock::now()) {}
 
 AsioScheduler::~AsioScheduler() {
+  alive_.reset();
   os_timer_.cancel();
 }
 
@@ -21,17 +24,41 @@ void AsioScheduler::OnNextDeadlineChanged() {
 void AsioScheduler::Rearm() {
   auto next = NextDeadline();
   if (!next) {
-    os_timer_.cancel();
+    if (os_deadline_) {
+      os_timer_.cancel();
+      os_deadline_.reset();
+    }
     return;
   }
+  if (*next <= Now()) {
+    // Already due (a zero-delay timer, e.g. an unpaced bus's round): run it from the event loop's
+    // queue. An OS timer set in the past costs two timerfd_settime calls, an epoll_wait and a
+    // timer interrupt per expiry. RunDue keeps the order (deadline, then arming order) either way.
+    if (!run_posted_) {
+      run_posted_ = true;
+      asio::post(os_timer_.get_executor(), [this, alive = std::weak_ptr<int>(alive_)] {
+        if (alive.expired()) return;
+        run_posted_ = false;
+        RunDueNow();
+      });
+    }
+    return;
+  }
+  if (os_deadline_ == next) return;  // already waiting for it
+  os_deadline_ = next;
   os_timer_.expires_at(epoch_ + next->time_since_epoch());
   os_timer_.async_wait([this](const asio::error_code& ec) {
     if (ec) return;  // cancelled: a newer deadline re-armed the timer
-    running_due_ = true;
-    RunDue(Now(), nullptr);
-    running_due_ = false;
-    Rearm();
+    os_deadline_.reset();
+    RunDueNow();
   });
+}
+
+void AsioScheduler::RunDueNow() {
+  running_due_ = true;
+  RunDue(Now(), nullptr);
+  running_due_ = false;
+  Rearm();
 }
 
 }  // namespace canfleet

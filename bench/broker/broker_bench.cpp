@@ -32,8 +32,10 @@
 #include <vector>
 
 #include "bus/frame_timing.hpp"
+#include "bus/wire/message_writer.hpp"
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
+#include "orchestrator/transport/round_encoding.hpp"
 
 namespace canfleet::broker {
 namespace {
@@ -63,22 +65,61 @@ CanFrame EightBytes(std::uint32_t id, std::uint8_t seed) {
 
 /// Counts deliveries; one designated port (the "pump") submits the next batch for every port when
 /// its own batch is confirmed, so the Asio run is a closed loop with one timer per round.
+/// With `encode`, it also does a TCP/Unix session's work per round: the frames go into a
+/// wire::MessageWriter as transport::detail::Session puts them (copies of the round's records,
+/// encoded once for all sessions), closed into a message, then dropped.
 class CountingSink : public PortSink {
  public:
-  void Deliver(std::span<const TimedFrame> frames) override { deliveries += frames.size(); }
+  void Deliver(std::span<const TimedFrame> frames) override {
+    deliveries += frames.size();
+    if (!encode) return;
+    writer.AddFrames(wire::MessageType::kFrames, frames, [](const TimedFrame& f) {
+      return wire::StampedFrame{f.frame, f.time};
+    });
+    Send();
+  }
+  /// With `encode`: what transport::detail::Session does, copies of one encoding of the round.
+  /// Without: the default (Deliver), as for a sink that only implements Deliver.
+  void DeliverShared(const SharedRound& round, std::span<const FrameRun> runs) override {
+    if (!encode) {
+      PortSink::DeliverShared(round, runs);
+      return;
+    }
+    const std::uint8_t* records = transport::SharedRecords(round);
+    std::size_t frames = 0;
+    for (const FrameRun& run : runs)
+      frames += run.size();
+    writer.ExpectFrames(wire::MessageType::kFrames, frames);
+    for (const FrameRun& run : runs) {
+      writer.AddRecords(wire::MessageType::kFrames, records + std::size_t{run.begin} * wire::kFrameRecordSize,
+                        run.size());
+      deliveries += run.size();
+    }
+    Send();
+  }
   void ControllerChanged(const ControllerEvent&) override {}
   void TxConfirmed(std::span<const TimedFrame> frames) override {
     if (on_confirm) on_confirm(frames.size());
   }
+  /// What a session's write would send: closes the message, then forgets it.
+  void Send() {
+    bytes += writer.Bytes().size();
+    writer.Clear();
+  }
   std::uint64_t deliveries = 0;
+  std::uint64_t bytes = 0;
+  bool encode = false;
+  wire::MessageWriter writer;
   std::function<void(std::size_t)> on_confirm;
 };
 
 struct UnpacedFleet {
-  UnpacedFleet(Scheduler& scheduler, int ports, std::size_t batch) : broker(scheduler), batch_size(batch) {
+  UnpacedFleet(Scheduler& scheduler, int ports, std::size_t batch, bool encode = false)
+      : broker(scheduler), batch_size(batch) {
     broker.AddBus({.name = "bench", .paced = false, .tx_queue_capacity = 4 * batch});
     for (int i = 0; i < ports; ++i) {
       sinks.push_back(std::make_unique<CountingSink>());
+      sinks.back()->encode = encode;
       ids.push_back(broker.Attach("bench", "p" + std::to_string(i), *sinks.back()));
       std::vector<CanFrame> frames;
       for (std::size_t k = 0; k < batch; ++k)
@@ -110,10 +151,14 @@ struct Throughput {
   double cpu_share = 0;  ///< CPU seconds / wall seconds (1.0 = one core busy)
 };
 
-Throughput UnpacedSimulated(int ports, double seconds) {
+std::size_t BatchFor(int ports) {
+  return ports >= 32 ? 16 : 64;
+}
+
+Throughput UnpacedSimulated(int ports, double seconds, bool encode) {
   SimulatedScheduler s;
-  const std::size_t batch = ports >= 32 ? 16 : 64;
-  UnpacedFleet fleet(s, ports, batch);
+  const std::size_t batch = BatchFor(ports);
+  UnpacedFleet fleet(s, ports, batch, encode);
   std::uint64_t rounds = 0;
   const double cpu0 = CpuSeconds();
   const auto t0 = Clock::now();
@@ -136,7 +181,7 @@ Throughput UnpacedSimulated(int ports, double seconds) {
 Throughput UnpacedAsio(int ports, double seconds) {
   asio::io_context io;
   AsioScheduler s(io);
-  const std::size_t batch = ports >= 32 ? 16 : 64;
+  const std::size_t batch = BatchFor(ports);
   UnpacedFleet fleet(s, ports, batch);
   std::uint64_t rounds = 0;
   // The first port's confirmation of its batch arrives once per round: submit the next round
@@ -312,11 +357,40 @@ PacedResult PacedRealTime(std::uint32_t bitrate, Duration wall) {
   return Paced(s, bitrate, [&] { io.run_for(wall); });
 }
 
+/// A fixed amount of work, for instruction counts (valgrind --tool=callgrind): `rounds` rounds
+/// of the simulated unpaced run, after 16 warm-up rounds.
+int FixedRounds(int ports, std::uint64_t rounds, bool encode) {
+  SimulatedScheduler s;
+  UnpacedFleet fleet(s, ports, BatchFor(ports), encode);
+  for (int i = 0; i < 16; ++i) {
+    fleet.SubmitRound();
+    s.Advance(1ns);
+  }
+  const std::uint64_t warm = fleet.Deliveries();
+  for (std::uint64_t i = 0; i < rounds; ++i) {
+    fleet.SubmitRound();
+    s.Advance(1ns);
+  }
+  std::printf("ports %d, %s: %llu rounds, %llu deliveries\n", ports, encode ? "encode" : "count",
+              static_cast<unsigned long long>(rounds),
+              static_cast<unsigned long long>(fleet.Deliveries() - warm));
+  return 0;
+}
+
 }  // namespace
 }  // namespace canfleet::broker
 
 int main(int argc, char** argv) {
   using namespace canfleet::broker;
+  if (argc > 1 && std::string(argv[1]) == "--rounds") {
+    // canfleet_broker_bench --rounds N PORTS [encode]
+    if (argc < 4) {
+      std::fprintf(stderr, "usage: canfleet_broker_bench --rounds ROUNDS PORTS [encode]\n");
+      return 2;
+    }
+    return FixedRounds(std::atoi(argv[3]), std::strtoull(argv[2], nullptr, 10),
+                       argc > 4 && std::string(argv[4]) == "encode");
+  }
   const double seconds = argc > 1 ? std::atof(argv[1]) : 1.0;
 
   std::printf("canfleet broker, in process (%u hardware threads)\n\n", std::thread::hardware_concurrency());
@@ -325,9 +399,12 @@ int main(int argc, char** argv) {
   std::printf("| ports | driver    | deliveries/s | frames/s   | CPU  | deliveries per CPU-s |\n");
   std::printf("|------:|-----------|-------------:|-----------:|-----:|---------------------:|\n");
   for (int ports : {2, 8, 32}) {
-    const Throughput sim = UnpacedSimulated(ports, seconds);
+    const Throughput sim = UnpacedSimulated(ports, seconds, false);
     std::printf("| %5d | simulated | %12.0f | %10.0f | %3.0f%% | %20.0f |\n", ports, sim.deliveries_per_s,
                 sim.frames_per_s, 100 * sim.cpu_share, sim.deliveries_per_s / sim.cpu_share);
+    const Throughput wire = UnpacedSimulated(ports, seconds, true);
+    std::printf("| %5d | sim+wire  | %12.0f | %10.0f | %3.0f%% | %20.0f |\n", ports, wire.deliveries_per_s,
+                wire.frames_per_s, 100 * wire.cpu_share, wire.deliveries_per_s / wire.cpu_share);
     const Throughput real = UnpacedAsio(ports, seconds);
     std::printf("| %5d | asio      | %12.0f | %10.0f | %3.0f%% | %20.0f |\n", ports, real.deliveries_per_s,
                 real.frames_per_s, 100 * real.cpu_share, real.deliveries_per_s / real.cpu_share);

@@ -37,6 +37,13 @@
 namespace canfleet::bench {
 namespace {
 
+/// The broker under test: CANFLEET_BENCH_BROKER when set (to compare two builds in one run, runs
+/// interleaved), else the one built with this benchmark.
+std::string BrokerProgram() {
+  const char* other = std::getenv("CANFLEET_BENCH_BROKER");
+  return other != nullptr && *other != '\0' ? other : PROGRAM_CANFLEET_BROKER;
+}
+
 using namespace std::chrono_literals;
 
 enum class Path { kRaw, kUnix, kTcp };
@@ -103,7 +110,7 @@ Result Run(Path path, int ports, bool latency, const Options& o) {
   } else {
     const std::string ready = dir.File("ready");
     server = std::make_unique<BenchProcess>(std::vector<std::string>{
-        PROGRAM_CANFLEET_BROKER, "--bus", "can0:1M:unpaced", "--listen",
+        BrokerProgram(), "--bus", "can0:1M:unpaced", "--listen",
         path == Path::kTcp ? "tcp://127.0.0.1:0" : "unix://" + dir.File("broker.sock"), "--ready-file", ready,
         "--log-level", "warn"});
     const auto deadline = std::chrono::steady_clock::now() + 10s;

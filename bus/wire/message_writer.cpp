@@ -1,5 +1,6 @@
 #include "bus/wire/message_writer.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -20,14 +21,25 @@ constexpr std::size_t kMaxBatchRecordsBytes = kMaxFramesPerMessage * kFrameRecor
 constexpr std::size_t kMaxBatchHeader = 3 + 1 + 3 + 1 + 3;
 static_assert(VarintSize(kMaxBatchRecordsBytes + 16) <= 3);
 
+/// The header of a batch of `records` bytes: Envelope length, tag, FrameBatch length, tag,
+/// records length.
+constexpr std::size_t BatchHeaderSize(std::size_t records) {
+  const std::size_t inner = 1 + VarintSize(records) + records;
+  const std::size_t envelope = 1 + VarintSize(inner) + inner;
+  return VarintSize(envelope) + envelope - records;
+}
+static_assert(BatchHeaderSize(kMaxBatchRecordsBytes) <= kMaxBatchHeader);
+
 }  // namespace
 
-void MessageWriter::OpenBatch(MessageType kind) {
+void MessageWriter::OpenBatch(MessageType kind, std::size_t expected) {
   batch_open_ = true;
   batch_kind_ = kind;
   batch_start_ = buffer_.size();
   batch_frames_ = 0;
-  buffer_.Extend(kMaxBatchHeader);
+  batch_header_ =
+      BatchHeaderSize(std::min(std::max<std::size_t>(expected, 1), kMaxFramesPerMessage) * kFrameRecordSize);
+  buffer_.Extend(batch_header_);
 }
 
 void MessageWriter::CloseBatch() {
@@ -48,12 +60,16 @@ void MessageWriter::CloseBatch() {
   *p++ = kTagBatchRecords;
   p = WriteVarint(records, p);
   const auto header_size = static_cast<std::size_t>(p - header);
-  std::uint8_t* start = buffer_.data() + batch_start_;
-  if (header_size < kMaxBatchHeader) {
-    std::memmove(start + header_size, start + kMaxBatchHeader, records);
-    buffer_.Shrink(buffer_.size() - (kMaxBatchHeader - header_size));
+  if (header_size < batch_header_) {
+    std::uint8_t* start = buffer_.data() + batch_start_;
+    std::memmove(start + header_size, start + batch_header_, records);
+    buffer_.Shrink(buffer_.size() - (batch_header_ - header_size));
+  } else if (header_size > batch_header_) {
+    buffer_.Extend(header_size - batch_header_);  // may move the buffer: take `start` after
+    std::uint8_t* start = buffer_.data() + batch_start_;
+    std::memmove(start + header_size, start + batch_header_, records);
   }
-  std::memcpy(start, header, header_size);
+  std::memcpy(buffer_.data() + batch_start_, header, header_size);
 }
 
 template <class Fill>
@@ -115,6 +131,7 @@ void MessageWriter::Swap(MessageWriter& other) noexcept {
   std::swap(batch_open_, other.batch_open_);
   std::swap(batch_kind_, other.batch_kind_);
   std::swap(batch_start_, other.batch_start_);
+  std::swap(batch_header_, other.batch_header_);
   std::swap(batch_frames_, other.batch_frames_);
   std::swap(frames_, other.frames_);
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string_view>
 
@@ -40,7 +41,7 @@ class MessageWriter {
   void AddFrames(MessageType kind, std::span<const T> items, Stamp&& stamp) {
     std::size_t done = 0;
     while (done < items.size()) {
-      const std::size_t n = std::min(Room(kind), items.size() - done);
+      const std::size_t n = std::min(Room(kind, items.size() - done), items.size() - done);
       std::uint8_t* out = buffer_.Extend(n * kFrameRecordSize);
       for (std::size_t i = 0; i < n; ++i, out += kFrameRecordSize) {
         const StampedFrame s = stamp(items[done + i]);
@@ -51,6 +52,23 @@ class MessageWriter {
       done += n;
     }
   }
+
+  /// Appends `count` records already encoded by EncodeRecord (kFrameRecordSize bytes each, e.g.
+  /// one encoding of a broker round shared by every session): a copy, no encoding.
+  void AddRecords(MessageType kind, const std::uint8_t* records, std::size_t count) {
+    while (count != 0) {
+      const std::size_t n = std::min(Room(kind, count), count);
+      std::memcpy(buffer_.Extend(n * kFrameRecordSize), records, n * kFrameRecordSize);
+      batch_frames_ += n;
+      frames_ += n;
+      records += n * kFrameRecordSize;
+      count -= n;
+    }
+  }
+
+  /// Announces that `count` frames of `kind` follow (e.g. the runs of one delivery): a batch
+  /// opened now reserves a header of the right size, so closing it moves nothing. Optional.
+  void ExpectFrames(MessageType kind, std::size_t count) { Room(kind, count); }
 
   void AddHello(const Hello& hello);
   void AddHelloReply(const HelloReply& reply);
@@ -84,20 +102,21 @@ class MessageWriter {
 
  private:
   void AddRecord(MessageType kind, const CanFrame& frame, BusTime time) {
-    Room(kind);
+    Room(kind, kMaxFramesPerMessage);
     EncodeRecord(frame, time, buffer_.Extend(kFrameRecordSize));
     ++batch_frames_;
     ++frames_;
   }
   /// Makes sure a batch of `kind` is open and has room; returns how many frames it can still take.
-  std::size_t Room(MessageType kind) {
+  /// A batch opened here reserves the header for `expected` frames (it grows if more come).
+  std::size_t Room(MessageType kind, std::size_t expected) {
     if (batch_open_ && batch_kind_ == kind && batch_frames_ < kMaxFramesPerMessage)
       return kMaxFramesPerMessage - batch_frames_;
     CloseBatch();
-    OpenBatch(kind);
+    OpenBatch(kind, expected);
     return kMaxFramesPerMessage;
   }
-  void OpenBatch(MessageType kind);
+  void OpenBatch(MessageType kind, std::size_t expected);
   /// Appends a protobuf-encoded Envelope.
   template <class Fill>
   void AppendProto(Fill&& fill);
@@ -107,6 +126,7 @@ class MessageWriter {
   bool batch_open_ = false;
   MessageType batch_kind_ = MessageType::kFrames;
   std::size_t batch_start_ = 0;
+  std::size_t batch_header_ = 0;  ///< bytes reserved for its header
   std::size_t batch_frames_ = 0;
   std::size_t frames_ = 0;
 };

@@ -1,6 +1,7 @@
 #include "orchestrator/broker/virtual_bus.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -34,6 +35,12 @@ std::size_t LogCapacity(const BusConfig& config) {
   if (!config.paced) return kUnpaced;
   const double window_bits = std::chrono::duration<double>(config.stats_window).count() * config.bitrate;
   return static_cast<std::size_t>(std::min(window_bits / kShortestTransferBits + 16, kMax));
+}
+
+/// SharedRound ids: unique across the buses (and brokers) of the process.
+std::uint64_t NextRoundId() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
 }
 
 /// What the wire carries: bytes beyond the DLC are not part of a frame (and a remote frame has
@@ -72,6 +79,8 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
       free_at_(created_),
       log_(LogCapacity(config_)) {
   delayed_.reserve(256);
+  round_.frames_.reserve(256);
+  round_.id_ = NextRoundId();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -79,11 +88,13 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
 
 Port& VirtualBus::Attach(PortId id, std::string name, PortSink& sink, AttachOptions options) {
   auto port = std::make_unique<Port>(id, std::move(name), sink, options, Now(), config_.tx_queue_capacity);
-  port->rx.reserve(64);
+  port->round_begin = static_cast<std::uint32_t>(round_.frames_.size());  // nothing from before it attached
+  port->exceptions.reserve(64);
   port->tx.reserve(64);
   port->events.reserve(4);
   Port& ref = *port;
   ports_.push_back(std::move(port));
+  Disturb();
   // A new port acknowledges: unpaced ports waiting after an ACK error may try again.
   for (auto& p : ports_)
     p->ack_blocked = false;
@@ -97,6 +108,7 @@ void VirtualBus::Detach(Port& port) {
     // reaches the port. Its outbox is discarded by the flush.
     port.detached = true;
     port.sink = nullptr;
+    Disturb();
     port.queue.clear();
     ++port.queue_epoch;
     if (port.recover_at) {
@@ -164,6 +176,7 @@ bool VirtualBus::ForceBusOff(Port& port, bool hold) {
       return true;
     }
     port.hold_bus_off = hold;
+    Disturb();
     Emit(port, port.controller.ForceBusOff());
     EnterBusOff(port, Now());
     return true;
@@ -173,6 +186,7 @@ bool VirtualBus::ForceBusOff(Port& port, bool hold) {
 bool VirtualBus::HoldErrorPassive(Port& port, bool on) {
   return WithRound([&] {
     if (port.detached || port.controller.ErrorPassiveHeld() == on) return false;
+    Disturb();
     Emit(port, port.controller.HoldErrorPassive(on));
     return true;
   });
@@ -426,31 +440,47 @@ void VirtualBus::Complete(const InFlight& transfer) {
     const bool repeat =
         faults && faults_.EvaluateDelivery(tx.id, frame, transfer.start, transfer.entry.repetition);
     const TimedFrame timed{frame, transfer.end};
-    for (std::size_t i = 0; i < ports_.size(); ++i) {
-      Port& rx = *ports_[i];
-      if (&rx == &tx || !receives(rx)) continue;
-      const FaultStage::Decision decision = faults ? faults_.ForReceiver(rx.id) : FaultStage::Decision{};
-      switch (decision.kind) {
-        case FaultStage::Decision::kDeliver:
-          rx.rx.push_back(timed);
-          ++rx.rx_frames;
-          ++deliveries_;
-          break;
-        case FaultStage::Decision::kDrop:
-          ++rx.fault_drops;
-          ++fault_drops_;
-          break;
-        case FaultStage::Decision::kDelay:
-          delayed_.push_back({transfer.end + decision.delay, delay_seq_++, rx.id, frame});
-          std::push_heap(delayed_.begin(), delayed_.end(), DueLater);
-          ++fault_delays_;
-          break;
+    // Written once for every receiver (the shared round); a port that does not receive it skips
+    // it. The sender never receives its own frame.
+    const std::uint32_t index = ShareFrame(timed);
+    tx.exceptions.push_back(index);
+    std::uint64_t delivered = 0;
+    if (!faults && ReceiversAtRest(tx, transfer.start))
+      delivered = ports_.size() - 1;  // every other port, nothing to count: no loop
+    else
+      for (std::size_t i = 0; i < ports_.size(); ++i) {
+        Port& rx = *ports_[i];
+        if (&rx == &tx) continue;
+        if (!receives(rx)) {
+          rx.exceptions.push_back(index);
+          continue;
+        }
+        const FaultStage::Decision decision = faults ? faults_.ForReceiver(rx.id) : FaultStage::Decision{};
+        switch (decision.kind) {
+          case FaultStage::Decision::kDeliver:
+            ++delivered;  // rx_frames: counted when the port is flushed
+            break;
+          case FaultStage::Decision::kDrop:
+            rx.exceptions.push_back(index);
+            ++rx.fault_drops;
+            ++fault_drops_;
+            break;
+          case FaultStage::Decision::kDelay:
+            rx.exceptions.push_back(index);
+            delayed_.push_back({transfer.end + decision.delay, delay_seq_++, rx.id, frame});
+            std::push_heap(delayed_.begin(), delayed_.end(), DueLater);
+            ++fault_delays_;
+            break;
+        }
+        // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8). Usually nothing to
+        // count (error-active, REC 0): tested first. (With every receiver so, and no fault rule,
+        // this loop does not run at all: ReceiversAtRest.)
+        if (!rx.options.listen_only && !rx.controller.ReceiveSuccessChangesNothing()) {
+          Emit(rx, rx.controller.OnReceiveSuccess());
+          Disturb();  // REC changed
+        }
       }
-      // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8). Usually nothing to
-      // count (error-active, REC 0): tested first, this is the hot loop of the broker.
-      if (!rx.options.listen_only && !rx.controller.ReceiveSuccessChangesNothing())
-        Emit(rx, rx.controller.OnReceiveSuccess());
-    }
+    deliveries_ += delivered;
     if (faults) faults_.EndOfTransfer(transfer.start);
     if (tx_live && transfer.entry.babble) {
       // Not the node's frame: no confirmation, nothing leaves its queue.
@@ -473,12 +503,13 @@ void VirtualBus::Complete(const InFlight& transfer) {
   }
 
   ++error_frames_;
+  Disturb();  // counters change below
   CanFrame error_frame;
   error_frame.id = frame.id;
   error_frame.flags = static_cast<std::uint8_t>(CanFrame::kError | (frame.flags & CanFrame::kExtended));
   for (std::size_t i = 0; i < ports_.size(); ++i) {
     Port& p = *ports_[i];
-    if (p.options.error_frames && receives(p)) p.rx.push_back({error_frame, transfer.end});
+    if (p.options.error_frames && receives(p)) AddPrivateFrame(p, {error_frame, transfer.end});
   }
   if (tx_live) {
     // Transmit error: TEC + 8 (rule 3), except an ACK error of an error-passive transmitter
@@ -506,7 +537,7 @@ void VirtualBus::Complete(const InFlight& transfer) {
 void VirtualBus::DeliverDelayed(const Delayed& delayed) {
   Port* rx = Find(delayed.receiver);
   if (rx == nullptr || rx->controller.State() == ControllerState::kBusOff) return;
-  rx->rx.push_back({delayed.frame, delayed.due});
+  AddPrivateFrame(*rx, {delayed.frame, delayed.due});
   ++rx->rx_frames;
   ++deliveries_;
 }
@@ -517,6 +548,7 @@ void VirtualBus::Recover(Port& port) {
     --pending_recoveries_;
   }
   port.hold_bus_off = false;
+  Disturb();
   Emit(port, port.controller.Recover());
   // The recovered controller acknowledges again: unpaced ports waiting after an ACK error may
   // try again (as when a port attaches).
@@ -525,6 +557,7 @@ void VirtualBus::Recover(Port& port) {
 }
 
 void VirtualBus::EnterBusOff(Port& port, BusTime at) {
+  Disturb();
   // A bus-off node's pending frames are not sent: the queue is dropped (counted).
   port.bus_off_drops += port.queue.size();
   port.queue.clear();
@@ -544,7 +577,26 @@ void VirtualBus::SuspendIfPassive(Port& port, BusTime end) {
 }
 
 void VirtualBus::Emit(Port& port, const std::optional<ControllerEvent>& event) {
-  if (event) port.events.push_back({port.rx.size(), port.tx.size(), *event});
+  if (!event) return;
+  port.events.push_back({round_.frames_.size(), port.tx.size(), *event});
+  Disturb();  // the port's state changed
+}
+
+bool VirtualBus::ReceiversAtRest(const Port& tx, BusTime start) {
+  if (!rest_.valid) {
+    rest_ = RestSummary{.valid = true};
+    for (const auto& p : ports_) {
+      rest_.newest_attach = std::max(rest_.newest_attach, p->attached_at);
+      const bool at_rest = !p->detached && p->controller.State() != ControllerState::kBusOff &&
+                           (p->options.listen_only || p->controller.ReceiveSuccessChangesNothing());
+      if (!at_rest) {
+        ++rest_.busy;
+        rest_.busy_port = p.get();
+      }
+    }
+  }
+  if (config_.paced && rest_.newest_attach > start) return false;
+  return rest_.busy == 0 || (rest_.busy == 1 && rest_.busy_port == &tx);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -589,25 +641,72 @@ void VirtualBus::FlushAll() {
     again = false;
     for (std::size_t i = 0; i < ports_.size(); ++i) {
       Port& port = *ports_[i];
-      if (!port.HasOutbox()) continue;
+      if (!HasOutbox(port)) continue;
       FlushPort(port);
       again = true;
     }
   }
+  ResetRound();
+}
+
+void VirtualBus::ResetRound() {
+  if (round_.frames_.empty()) return;
+  round_.frames_.clear();
+  round_.id_ = NextRoundId();
+  private_.clear();
+  for (auto& p : ports_)
+    p->round_begin = 0;
 }
 
 void VirtualBus::FlushPort(Port& port) {
-  // rx and tx do not change while sinks run (nothing is processed inside a round's flush), so the
-  // spans stay valid; events may be appended (the loop re-reads the size).
-  std::size_t rx_done = 0;
+  // The shared round and tx do not change while sinks run (nothing is processed inside a round's
+  // flush), so the spans stay valid; events may be appended (the loop re-reads the size).
+  const std::span<const std::uint32_t> exceptions = port.exceptions.items();
+  std::size_t next_exception = 0;
+  auto next_private = std::lower_bound(private_.begin(), private_.end(), port.round_begin);
+  std::uint32_t rx_done = port.round_begin;
   std::size_t tx_done = 0;
-  auto frames_up_to = [&](std::size_t rx_mark, std::size_t tx_mark) {
-    if (rx_mark > rx_done) {
-      if (port.sink != nullptr) port.sink->Deliver(port.rx.frames().subspan(rx_done, rx_mark - rx_done));
-      rx_done = rx_mark;
+  // The port's share of round_ [rx_done, rx_mark) as runs: cut at its own exceptions (skipped
+  // frames) and at frames addressed to other ports alone.
+  auto deliver_up_to = [&](std::uint32_t rx_mark) {
+    constexpr std::uint32_t kNone = ~std::uint32_t{0};
+    runs_.clear();
+    std::uint32_t run_begin = rx_done;
+    std::uint32_t included = 0;
+    for (;;) {
+      const std::uint32_t exception = next_exception < exceptions.size() ? exceptions[next_exception] : kNone;
+      const std::uint32_t exception_at = exception == kNone ? kNone : exception & ~Port::kInclude;
+      const std::uint32_t private_at = next_private != private_.end() ? *next_private : kNone;
+      const std::uint32_t at = std::min(exception_at, private_at);
+      if (at >= rx_mark) break;
+      bool cut = true;
+      if (exception_at == at) {
+        ++next_exception;
+        if ((exception & Port::kInclude) != 0) {
+          cut = false;  // addressed to this port: part of its run
+          ++included;
+        }
+      }
+      if (private_at == at) ++next_private;
+      if (cut) {
+        if (at > run_begin) runs_.push_back({run_begin, at});
+        run_begin = at + 1;
+      }
     }
+    if (rx_mark > run_begin) runs_.push_back({run_begin, rx_mark});
+    rx_done = rx_mark;
+    if (runs_.empty()) return;
+    std::uint64_t received = 0;
+    for (const FrameRun& run : runs_)
+      received += run.size();
+    // Private frames were counted when added (delayed) or are not counted (error frames).
+    port.rx_frames += received - included;
+    if (port.sink != nullptr) port.sink->DeliverShared(round_, runs_);
+  };
+  auto frames_up_to = [&](std::size_t rx_mark, std::size_t tx_mark) {
+    if (rx_mark > rx_done) deliver_up_to(static_cast<std::uint32_t>(rx_mark));
     if (tx_mark > tx_done) {
-      if (port.sink != nullptr) port.sink->TxConfirmed(port.tx.frames().subspan(tx_done, tx_mark - tx_done));
+      if (port.sink != nullptr) port.sink->TxConfirmed(port.tx.items().subspan(tx_done, tx_mark - tx_done));
       tx_done = tx_mark;
     }
   };
@@ -616,8 +715,9 @@ void VirtualBus::FlushPort(Port& port) {
     frames_up_to(pending.rx_mark, pending.tx_mark);
     if (port.sink != nullptr) port.sink->ControllerChanged(pending.event);
   }
-  frames_up_to(port.rx.size(), port.tx.size());
-  port.rx.clear();
+  frames_up_to(round_.frames_.size(), port.tx.size());
+  port.round_begin = static_cast<std::uint32_t>(round_.frames_.size());
+  port.exceptions.clear();
   port.tx.clear();
   port.events.clear();
 }
@@ -630,6 +730,7 @@ void VirtualBus::Sweep() {
       [on_wire](const SubmissionOrder::Entry& e) { return e.port->detached && e.port != on_wire; });
   std::erase_if(ports_,
                 [on_wire](const std::unique_ptr<Port>& p) { return p->detached && p.get() != on_wire; });
+  Disturb();
   sweep_needed_ = on_wire != nullptr && on_wire->detached;
 }
 

@@ -59,16 +59,21 @@ struct Port {
   bool babbling = false;
   QueuedFrame babble{};
 
-  // Outbox of the current round: frames, confirmations and controller events, in bus order.
+  // What the current round has for this port, in bus order. Received frames are not copied per
+  // port: the port receives the bus's shared round from `round_begin` on, except its own frames
+  // and `exceptions` (VirtualBus::SkipFrame, IncludeFrame).
   struct PendingEvent {
-    std::size_t rx_mark;  ///< rx frames that precede the event
+    std::size_t rx_mark;  ///< shared-round frames (received or not) that precede the event
     std::size_t tx_mark;
     ControllerEvent event;
   };
-  Outbox rx;
+  std::uint32_t round_begin = 0;  ///< first shared-round frame not yet flushed to this port
+  /// Ascending shared-round indexes: a frame of the round this port does not receive, or, with
+  /// kInclude, a frame addressed to it alone.
+  AppendBuffer<std::uint32_t> exceptions;
+  static constexpr std::uint32_t kInclude = std::uint32_t{1} << 31;
   Outbox tx;
   std::vector<PendingEvent> events;
-  bool HasOutbox() const { return !rx.empty() || !tx.empty() || !events.empty(); }
 
   std::uint64_t tx_frames = 0, rx_frames = 0, tx_errors = 0, rx_errors = 0;
   std::uint64_t queue_drops = 0, invalid_drops = 0, bus_off_drops = 0, fault_drops = 0;
@@ -160,6 +165,30 @@ class VirtualBus {
   void EnterBusOff(Port& port, BusTime at);
   void SuspendIfPassive(Port& port, BusTime end);
   void Emit(Port& port, const std::optional<ControllerEvent>& event);
+  /// Appends a frame to the shared round (every port receives it unless it skips it); returns its
+  /// index.
+  std::uint32_t ShareFrame(const TimedFrame& frame) {
+    const auto index = static_cast<std::uint32_t>(round_.frames_.size());
+    round_.frames_.push_back(frame);
+    return index;
+  }
+  /// Appends a frame to the shared round for `port` alone (a delayed frame, an error frame).
+  void AddPrivateFrame(Port& port, const TimedFrame& frame) {
+    const std::uint32_t index = ShareFrame(frame);
+    private_.push_back(index);
+    port.exceptions.push_back(index | Port::kInclude);
+  }
+  bool HasOutbox(const Port& port) const {
+    return port.round_begin < round_.frames_.size() || !port.tx.empty() || !port.events.empty();
+  }
+  /// Ends the round's sharing: every port has been flushed.
+  void ResetRound();
+  /// Whether a frame sent by `tx` that started at `start` needs no work per receiver: no port
+  /// other than `tx` is detached, bus-off, counting REC down or (paced) attached after `start`.
+  /// Then every other port receives it and nothing else changes (the fast path of Complete).
+  bool ReceiversAtRest(const Port& tx, BusTime start);
+  /// Something ReceiversAtRest depends on may have changed.
+  void Disturb() { rest_.valid = false; }
   std::optional<BusTime> NextEvent() const;
   void Arm();
   void FlushAll();
@@ -186,6 +215,18 @@ class VirtualBus {
   std::optional<BusTime> last_round_;  ///< when the timer last ran a round
   bool in_round_ = false;
   bool sweep_needed_ = false;
+
+  SharedRound round_;  ///< the frames of the current round, shared by every port
+  /// Ascending indexes of round_ frames addressed to one port only (AddPrivateFrame).
+  std::vector<std::uint32_t> private_;
+  std::vector<FrameRun> runs_;  ///< FlushPort's scratch
+  /// ReceiversAtRest's summary of the ports, recomputed after Disturb.
+  struct RestSummary {
+    bool valid = false;
+    std::size_t busy = 0;             ///< ports not at rest
+    const Port* busy_port = nullptr;  ///< one of them
+    BusTime newest_attach{};          ///< latest attached_at
+  } rest_;
 
   TransmissionLog log_;
   std::uint64_t frames_ = 0, error_frames_ = 0, deliveries_ = 0;

@@ -4,6 +4,9 @@
 #include <asio/write.hpp>
 #include <stdexcept>
 
+#include "bus/wire/frame_record.hpp"
+#include "orchestrator/transport/round_encoding.hpp"
+
 namespace canfleet::transport::detail {
 
 namespace {
@@ -296,6 +299,24 @@ void Session::Deliver(std::span<const broker::TimedFrame> frames) {
     return;
   }
   filling_.AddFrames(wire::MessageType::kFrames, frames, Stamped);
+  ScheduleFlush();
+}
+
+void Session::DeliverShared(const broker::SharedRound& round, std::span<const broker::FrameRun> runs) {
+  std::size_t frames = 0;
+  for (const broker::FrameRun& run : runs)
+    frames += run.size();
+  if (filling_.size() >= options_.max_backlog_bytes) {
+    if (backlog_drops_ == 0) spdlog::warn("{}: not reading; dropping frames for it", label_);
+    backlog_drops_ += frames;
+    stats_->backlog_drops += frames;
+    return;
+  }
+  const std::uint8_t* records = transport::SharedRecords(round);
+  filling_.ExpectFrames(wire::MessageType::kFrames, frames);
+  for (const broker::FrameRun& run : runs)
+    filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{run.begin} * wire::kFrameRecordSize,
+                        run.size());
   ScheduleFlush();
 }
 

@@ -63,6 +63,8 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
 
   // broker::PortSink
   void Deliver(std::span<const broker::TimedFrame> frames) override;
+  /// Copies the runs from the round's wire encoding, made once per round for every session.
+  void DeliverShared(const broker::SharedRound& round, std::span<const broker::FrameRun> runs) override;
   void ControllerChanged(const ControllerEvent& event) override;
   void TxConfirmed(std::span<const broker::TimedFrame> frames) override;
 

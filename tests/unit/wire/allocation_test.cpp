@@ -45,5 +45,33 @@ TEST(WireAllocation, SteadyBatchesAllocateNothing) {
   EXPECT_FALSE(decoder.Failed()) << decoder.Error();
 }
 
+TEST(WireAllocation, SteadyPreEncodedBatchesAllocateNothing) {
+  // The broker's delivery path: one encoding of the round, copied by every session.
+  std::vector<std::uint8_t> records(500 * kFrameRecordSize);
+  for (std::size_t i = 0; i < 500; ++i)
+    EncodeRecord(CanFrame::Data(0x180 + (i % 64), {1, 2, 3, 4, 5, 6, 7, 8}),
+                 BusTime(static_cast<std::int64_t>(i)), records.data() + i * kFrameRecordSize);
+  MessageWriter filling;
+  MessageWriter writing;
+  std::size_t bytes = 0;
+  auto round = [&] {
+    for (int session = 0; session < 4; ++session) {
+      filling.AddRecords(MessageType::kFrames, records.data(), 100);
+      filling.AddRecords(MessageType::kFrames, records.data() + 101 * kFrameRecordSize, 399);
+      filling.AddTxConfirm(CanFrame::Data(0x200, {1}), BusTime(1));
+    }
+    filling.Swap(writing);
+    bytes += writing.Bytes().size();
+    writing.Clear();
+  };
+  for (int i = 0; i < 3; ++i)
+    round();
+  const auto before = canfleet::test::AllocationCount();
+  for (int i = 0; i < 100; ++i)
+    round();
+  EXPECT_EQ(canfleet::test::AllocationCount() - before, 0u);
+  EXPECT_GT(bytes, 100u * 4u * 499u * kFrameRecordSize);
+}
+
 }  // namespace
 }  // namespace canfleet::wire

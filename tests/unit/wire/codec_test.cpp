@@ -228,6 +228,44 @@ TEST(WireCodec, BulkAppendWritesWhatSingleAppendsWrite) {
   EXPECT_EQ(ToBytes(bulk.Bytes()), ToBytes(one_by_one.Bytes()));
 }
 
+TEST(WireCodec, PreEncodedRecordsWriteWhatAddFramesWrites) {
+  // AddRecords (the broker's shared round, encoded once for every session) and AddFrames must
+  // agree, in several pieces, across a batch split and after a message of another kind.
+  std::vector<StampedFrame> frames;
+  for (std::uint32_t i = 0; i < kMaxFramesPerMessage + 10; ++i)
+    frames.push_back({CanFrame::Data(0x100 + (i % 0x80), {std::uint8_t(i), 7}), BusTime(i)});
+  std::vector<std::uint8_t> records(frames.size() * kFrameRecordSize);
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    EncodeRecord(frames[i].frame, frames[i].time, records.data() + i * kFrameRecordSize);
+  MessageWriter encoded;
+  MessageWriter copied;
+  encoded.AddPing(1);
+  copied.AddPing(1);
+  const auto same = [](const StampedFrame& f) { return f; };
+  encoded.AddFrames(MessageType::kFrames, std::span<const StampedFrame>(frames), same);
+  copied.AddRecords(MessageType::kFrames, records.data(), 3);
+  copied.AddRecords(MessageType::kFrames, records.data() + 3 * kFrameRecordSize, frames.size() - 3);
+  copied.AddRecords(MessageType::kFrames, records.data(), 0);  // nothing
+  EXPECT_EQ(copied.frame_count(), frames.size());
+  EXPECT_EQ(ToBytes(copied.Bytes()), ToBytes(encoded.Bytes()));
+
+  // ExpectFrames only sizes the header: announcing fewer or more frames than follow gives the
+  // same bytes (the header grows or shrinks when the batch is closed).
+  for (std::size_t announced :
+       {std::size_t{0}, std::size_t{1}, std::size_t{5}, std::size_t{6}, frames.size()}) {
+    for (std::size_t count :
+         {std::size_t{1}, std::size_t{5}, std::size_t{6}, std::size_t{600}, frames.size()}) {
+      SCOPED_TRACE(std::to_string(announced) + " announced, " + std::to_string(count) + " written");
+      MessageWriter expected;
+      MessageWriter announcing;
+      expected.AddFrames(MessageType::kFrames, std::span<const StampedFrame>(frames).first(count), same);
+      announcing.ExpectFrames(MessageType::kFrames, announced);
+      announcing.AddRecords(MessageType::kFrames, records.data(), count);
+      EXPECT_EQ(ToBytes(announcing.Bytes()), ToBytes(expected.Bytes()));
+    }
+  }
+}
+
 TEST(WireCodec, RecordKeepsOnlyTheBytesOfTheFrame) {
   // Bytes beyond the DLC (and all of a remote frame's) travel as 0 (canfleet_wire.proto, FrameBatch).
   CanFrame f = CanFrame::Data(0x123, {1, 2});
