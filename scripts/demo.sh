@@ -2,6 +2,8 @@
 # The demo command: installs what it needs, builds, starts the demo fleet of topologies/ and shows
 # it live until Ctrl-C, then stops every process.
 #   scripts/demo.sh [TOPOLOGY]      default topologies/demo.textproto
+#   scripts/demo.sh --docker [--keep]   the same fleet in containers (scripts/docker-demo.sh:
+#                                   docker/compose.yaml, needs a Docker engine, no registry)
 #
 # What you see: `canfleet up` starts the orchestrator (broker, control API) and one process per
 # node; its log (boot-ups, configuration, EMCYs, the scenario's faults) goes to
@@ -10,6 +12,10 @@
 # demo topology's scenario injects and clears faults while you watch.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ "${1:-}" = --docker ]; then
+  shift
+  exec scripts/docker-demo.sh "$@"
+fi
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 topology=${1:-topologies/demo.textproto}
 

@@ -27,4 +27,8 @@ cmake -S . -B build "${common[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure
 
+# The container fleet on the real Docker engine (docker/compose.yaml): builds canfleet:dev, checks
+# heartbeat loss on stop/kill/disconnect; prints "SKIPPED: <reason>" when no Docker engine answers.
+tests/docker/run.sh
+
 scripts/fuzz.sh "${FUZZ_SECONDS:-15}"

@@ -86,7 +86,9 @@ int RunFleet(const UpOptions& options) {
   AsioScheduler scheduler(io);
   broker::Broker broker(scheduler);
   transport::BrokerServer server(io, broker);
-  socketcand::Server socketcand(io, broker, scheduler);
+  socketcand::ServerOptions socketcand_options;
+  socketcand_options.bind_address = options.socketcand_bind;
+  socketcand::Server socketcand(io, broker, scheduler, socketcand_options);
   std::unique_ptr<Fleet> fleet;
   std::unique_ptr<control::ControlServer> control_server;
   std::string control_endpoint, broker_endpoint;

@@ -10,11 +10,12 @@
 namespace canfleet::fleet {
 
 struct UpOptions {
-  std::filesystem::path topology;      ///< the topology file
-  std::optional<std::string> control;  ///< overrides Orchestrator.control (e.g. tcp://127.0.0.1:0)
-  std::optional<std::string> listen;   ///< overrides Orchestrator.listen (one broker endpoint)
-  std::filesystem::path node_binary;   ///< canfleet-node; empty: beside this executable, then PATH
-  std::filesystem::path ready_file;    ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
+  std::filesystem::path topology;             ///< the topology file
+  std::optional<std::string> control;         ///< overrides Orchestrator.control (e.g. tcp://127.0.0.1:0)
+  std::optional<std::string> listen;          ///< overrides Orchestrator.listen (one broker endpoint)
+  std::string socketcand_bind = "127.0.0.1";  ///< address the buses' socketcand endpoints listen on
+  std::filesystem::path node_binary;          ///< canfleet-node; empty: beside this executable, then PATH
+  std::filesystem::path ready_file;  ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
   std::string log_level = "info";
   bool no_start = false;         ///< load and start the buses, but no node processes
   bool telemetry = true;         ///< BusStats and FaultEvents on DDS

@@ -14,6 +14,7 @@ namespace {
 struct UpArgs {
   std::string topology;
   std::string listen;
+  std::string socketcand_bind = "127.0.0.1";
   std::string node_binary;
   std::string ready_file;
   std::string log_level = "info";
@@ -27,6 +28,7 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.topology = args.topology;
   if (global.control_given) options.control = global.control;
   if (!args.listen.empty()) options.listen = args.listen;
+  options.socketcand_bind = args.socketcand_bind;
   options.node_binary = args.node_binary;
   options.ready_file = args.ready_file;
   options.log_level = args.log_level;
@@ -64,6 +66,9 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
       ->check(CLI::ExistingFile);
   up->add_option("--listen", args->listen,
                  "Broker endpoint for nodes, overriding the topology (tcp://HOST:PORT)");
+  up->add_option("--socketcand-bind", args->socketcand_bind,
+                 "Address the buses' socketcand endpoints listen on (0.0.0.0 in a container)")
+      ->capture_default_str();
   up->add_option("--node-binary", args->node_binary,
                  "canfleet-node to start (default: beside canfleet, then PATH)");
   up->add_option("--ready-file", args->ready_file,

@@ -78,6 +78,17 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
   EXPECT_EQ(monitor.Node("can0", 2)->status.device, "quad-controller");
   EXPECT_EQ(monitor.Node("can0", 2)->status.heartbeat_producer_ms, 200);
 
+  // CiA 301 §7.2.8.3.2.2: a consumer starts monitoring at the first heartbeat it receives after
+  // 1016h is written. quad-2 may have been started a few ms ago: wait until it watches quad-1.
+  ASSERT_TRUE(monitor.Until(
+      [&] {
+        for (const auto& consumer : monitor.Node("can0", 2)->status.heartbeat_consumers)
+          if (consumer.node_id == 1 && consumer.state == telemetry::HeartbeatConsumerState::kActive)
+            return true;
+        return false;
+      },
+      kFleetPatience));
+
   // A heartbeat loss: the orchestrator's FaultEvent, quad-2's EMCY 8130h (CiA 301 §7.2.7.2, Quad
   // manual §4.2) and its NMT change to pre-operational all arrive as DDS samples.
   const auto injected = fleet.Cli({"fault", "inject", "heartbeat-loss", "--node", "quad-1"});
@@ -96,7 +107,8 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
           return e.kind == EventKind::kEmcy && e.node_id == 2 && e.emcy && e.emcy->emcy.code == 0x8130;
         });
       },
-      kFleetPatience));
+      kFleetPatience))
+      << fleet.NodeLog("quad-2") << fleet.Log();
   EXPECT_TRUE(
       monitor.Until([&] { return monitor.Node("can0", 2)->status.nmt_state == NmtState::kPreOperational; },
                     kFleetPatience));

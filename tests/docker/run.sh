@@ -1,0 +1,309 @@
+#!/usr/bin/env bash
+# System test of the container fleet on the real Docker engine (docker/compose.yaml,
+# topologies/docker.textproto): build the image, bring the fleet up under a project of its own
+# and on free loopback ports (a running demo is not disturbed), wait until every node is
+# operational, silence quad-5 three ways and check what its heartbeat consumers report, bring it
+# back each time, tear everything down (always, also on failure or Ctrl-C).
+#
+#   tests/docker/run.sh [--no-build] [--keep]
+#     --no-build   use the existing image (default: scripts/docker-build.sh, fast when cached)
+#     --keep       leave the fleet running at the end (for a look; `scripts/docker-fleet.sh down`
+#                  with the printed CANFLEET_PROJECT removes it)
+# Environment: CANFLEET_DOCKER_SRC=DIR builds the image from DIR (scripts/docker-build.sh --src),
+#   e.g. `git archive HEAD | tar -x -C DIR` of the committed tree while the working tree has someone's
+#   half-written change; CANFLEET_IMAGE (default canfleet:dev).
+#
+# Prints "SKIPPED: <reason>" and exits 0 when no Docker engine answers; it never reports a pass
+# without having run. Exit 1 on any failed check ("FAIL: ..."), 2 on bad arguments.
+#
+# What it checks (quad-6 and dio-20 consume quad-5's heartbeat, 1500 ms; topologies/docker.textproto):
+#  1. every node attached to the broker and operational, read through the control API published on
+#     127.0.0.1 (host CLI, build/bin/canfleet, when built); the orchestrator configured the external
+#     nodes: quad-6's RPDO1 COB-ID 1400h sub 1 = 185h, quad-5's 1016h sub 1 = 000705DCh
+#  2. socketcand of can0 on its published loopback port: handshake and a frame in raw mode (compose.yaml
+#     runs canfleet up --socketcand-bind 0.0.0.0)
+#  3. telemetry over DDS across containers: canfleet-top --once in a container on the fleet's
+#     network shows all 5 nodes operational
+#  4. for each of `docker stop`, `docker kill` and `docker network disconnect` of quad-5:
+#     - quad-6 sends EMCY 8130h and holds 1003h sub 1 = 08058130h (Quad manual §4.1: description 08h
+#       "lost heartbeat", channel 05h = the producer's node-ID; EMCY code 8130h CiA 301 §7.2.7.1),
+#       error register 1001h bit 0 set (manual §4.2) and goes pre-operational (1029h sub 1 = 0,
+#       manual §3.1.9, CiA 301 §7.2.8.3.2.2 heartbeat consumer)
+#     - dio-20 (generic CiA 301 node) sends EMCY 8130h too
+#     - quad-5 back (docker start / network connect): quad-6 sends EMCY 0000h (error reset); after
+#       stop/kill quad-5 boots again and the orchestrator configures and starts it again (operational,
+#       1016h sub 1 = 000705DCh, 1017h = 500 read back); after a disconnect the same process is back,
+#       having itself lost quad-7's heartbeat (its own EMCY, pre-operational); after
+#       `canfleet nmt start` every node is operational again
+set -euo pipefail
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
+cd "$repo"
+
+build=1
+keep=0
+for arg in "$@"; do
+  case "$arg" in
+    --no-build) build=0 ;;
+    --keep) keep=1 ;;
+    -h | --help) awk 'NR > 1 && /^#/ {sub(/^# ?/, ""); print; next} NR > 1 {exit}' "$0"; exit 0 ;;
+    *) echo "tests/docker/run.sh: unknown argument '$arg'" >&2; exit 2 ;;
+  esac
+done
+
+log() { echo "docker-test: $*"; }
+checks=()
+unchecked=()
+pass() { checks+=("$*"); log "ok: $*"; }
+fail() {
+  echo "docker-test: FAIL: $*" >&2
+  exit 1
+}
+
+# ---- skip only when there is no engine -----------------------------------------------------------
+if ! command -v docker >/dev/null; then
+  echo "docker-test: SKIPPED: no 'docker' command on this machine (the container fleet test needs a Docker engine)"
+  exit 0
+fi
+if ! timeout 30 docker info >/dev/null 2>&1; then
+  echo "docker-test: SKIPPED: the Docker engine does not answer ('docker info' failed or timed out)"
+  exit 0
+fi
+if ! docker compose version >/dev/null 2>&1 && ! command -v docker-compose >/dev/null; then
+  fail "a Docker engine answers but no compose tool is installed ('docker compose' v2 or 'docker-compose')"
+fi
+command -v python3 >/dev/null || fail "python3 is needed to read canfleet status --json"
+
+t0=$(date +%s)
+elapsed() { echo "$(($(date +%s) - $1)) s"; }
+
+# ---- a project and host ports of its own ---------------------------------------------------------
+export CANFLEET_PROJECT="canfleet-test-$$"
+export CANFLEET_IMAGE="${CANFLEET_IMAGE:-canfleet:dev}"
+read -r CANFLEET_CONTROL_PORT CANFLEET_BROKER_PORT CANFLEET_CAN0_PORT CANFLEET_CAN1_PORT < <(python3 -c '
+import socket
+socks = [socket.socket() for _ in range(4)]
+for s in socks: s.bind(("127.0.0.1", 0))
+print(*[s.getsockname()[1] for s in socks])')
+export CANFLEET_CONTROL_PORT CANFLEET_BROKER_PORT CANFLEET_CAN0_PORT CANFLEET_CAN1_PORT
+# The fleet's network is a bridge of its own: DDS traffic stays on it whatever the domain.
+fleet() { scripts/docker-fleet.sh "$@"; }
+
+teardown() {
+  local rc=$?
+  if [ "$keep" = 1 ]; then
+    log "--keep: fleet left running: CANFLEET_PROJECT=$CANFLEET_PROJECT CANFLEET_CONTROL_PORT=$CANFLEET_CONTROL_PORT"
+  else
+    if [ "$rc" != 0 ]; then
+      log "orchestrator log (last 60 lines):"
+      fleet compose logs --no-color --tail 60 orchestrator 2>&1 | sed 's/^/  /' || true
+    fi
+    fleet down >/dev/null 2>&1 || log "WARNING: 'compose down' of $CANFLEET_PROJECT failed"
+    log "fleet $CANFLEET_PROJECT removed"
+  fi
+  if [ "$rc" = 0 ]; then
+    log "PASSED (${#checks[@]} checks passed, ${#unchecked[@]} not checked, $(elapsed "$t0"))"
+  else
+    log "FAILED (exit $rc)"
+  fi
+}
+trap teardown EXIT
+trap 'exit 130' INT TERM
+
+# ---- static: the compose file parses in every tool that is here ---------------------------------
+if command -v docker-compose >/dev/null; then
+  docker-compose -f docker/compose.yaml config -q || fail "docker-compose 1.x refuses docker/compose.yaml"
+  pass "docker-compose $(docker-compose version --short) accepts docker/compose.yaml"
+fi
+if docker compose version >/dev/null 2>&1; then
+  docker compose -f docker/compose.yaml config -q || fail "docker compose v2 refuses docker/compose.yaml"
+  pass "docker compose v2 accepts docker/compose.yaml"
+fi
+if docker stack config --help >/dev/null 2>&1; then
+  docker stack config -c docker/compose.yaml -c docker/stack.yaml >/dev/null 2>"$repo/build-docker-stack-config.err" ||
+    { cat "$repo/build-docker-stack-config.err" >&2; rm -f "$repo/build-docker-stack-config.err"; fail "docker stack config refuses docker/compose.yaml + docker/stack.yaml"; }
+  rm -f "$repo/build-docker-stack-config.err"
+  pass "docker stack config accepts docker/compose.yaml + docker/stack.yaml"
+fi
+
+# ---- image ---------------------------------------------------------------------------------------
+if [ "$build" = 1 ]; then
+  t=$(date +%s)
+  scripts/docker-build.sh --tag "$CANFLEET_IMAGE" ${CANFLEET_DOCKER_SRC:+--src "$CANFLEET_DOCKER_SRC"} 2>&1 | grep -E '^docker-build:|ERROR|error:' || true
+  [ "${PIPESTATUS[0]}" = 0 ] || fail "scripts/docker-build.sh failed"
+  log "image $CANFLEET_IMAGE built in $(elapsed "$t")"
+fi
+docker image inspect "$CANFLEET_IMAGE" >/dev/null 2>&1 || fail "no image $CANFLEET_IMAGE (run without --no-build)"
+
+# ---- helpers on `canfleet status --json` ---------------------------------------------------------
+cli() { fleet cli "$@"; }
+status_json() { cli status --json; }
+# node_get NAME FIELD: one field of one node from status (last_emcy.code, emcy_count, nmt_state, attached).
+node_get() {
+  status_json | python3 -c '
+import json, sys
+name, field = sys.argv[1], sys.argv[2]
+for n in json.load(sys.stdin)["nodes"]:
+    if n["name"] == name:
+        v = n
+        for part in field.split("."):
+            v = v.get(part, "") if isinstance(v, dict) else ""
+        print(str(v).lower() if isinstance(v, bool) else v)
+        sys.exit(0)
+sys.exit(1)' "$1" "$2"
+}
+# wait_for SECONDS DESCRIPTION COMMAND...: polls COMMAND every second until it succeeds.
+wait_for() {
+  local limit=$1 what=$2 start
+  shift 2
+  start=$(date +%s)
+  until "$@" >/dev/null 2>&1; do
+    [ $(($(date +%s) - start)) -lt "$limit" ] || fail "$what: not seen within $limit s"
+    sleep 1
+  done
+}
+sdo_u32() { cli sdo read "$1" "$2" "$3" u32; }
+sdo_u8() { cli sdo read "$1" "$2" "$3" u8; }
+sdo_u16() { cli sdo read "$1" "$2" "$3" u16; }
+expect_eq() { # DESCRIPTION ACTUAL EXPECTED (numbers, any base python reads)
+  python3 -c 'import sys; sys.exit(0 if int(sys.argv[1], 0) == int(sys.argv[2], 0) else 1)' "$2" "$3" ||
+    fail "$1: got $2, expected $3"
+}
+hex() { python3 -c 'import sys; print("%08Xh" % int(sys.argv[1], 0))' "$1"; }
+emcy_is() { [ "$(node_get "$1" emcy_count)" -gt "$2" ] && [ "$(node_get "$1" last_emcy.code)" = "$3" ]; }
+emcy_is_any() { [ "$(node_get "$1" emcy_count)" -gt "$2" ]; }
+nmt_is() { [ "$(node_get "$1" nmt_state)" = "$2" ]; }
+attached_is() { [ "$(node_get "$1" attached)" = "$2" ]; }
+
+# ---- 1. up --------------------------------------------------------------------------------------
+t=$(date +%s)
+log "project $CANFLEET_PROJECT, control API 127.0.0.1:$CANFLEET_CONTROL_PORT, socketcand 127.0.0.1:$CANFLEET_CAN0_PORT/$CANFLEET_CAN1_PORT"
+fleet compose up -d || fail "compose up failed"
+fleet wait --timeout 240 || fail "the fleet did not become operational"
+pass "fleet up, 5 nodes attached and operational via the control API on 127.0.0.1:$CANFLEET_CONTROL_PORT ($(elapsed "$t"))"
+for n in quad-5 quad-6 quad-7 dio-20 quad-9; do
+  [ "$(node_get $n process)" = external ] || fail "$n: process should be 'external' (its own container)"
+done
+expect_eq "quad-6 1400h sub 1 (RPDO1 COB-ID, set by the orchestrator)" "$(sdo_u32 quad-6 0x1400 1)" 0x185
+expect_eq "quad-5 1016h sub 1 (consumer of quad-7, 1500 ms)" "$(sdo_u32 quad-5 0x1016 1)" 0x000705DC
+pass "the orchestrator configured the external nodes (quad-6 1400h.1 = 185h, quad-5 1016h.1 = 000705DCh)"
+net=$(fleet network)
+
+# ---- 2. DDS telemetry across containers -----------------------------------------------------------
+top_out=$(timeout 90 docker run --rm --network "$net" "$CANFLEET_IMAGE" \
+  canfleet-top --once --color never --width 200 --height 40 2>&1) || true
+rows=$(printf '%s\n' "$top_out" | grep -cE '^can[01] +[0-9]+ +(quad-controller|generic) +OPER' || true)
+if [ "$rows" -ne 5 ]; then
+  printf '%s\n' "$top_out" >&2
+  fail "canfleet-top in a container on $net showed $rows of 5 nodes operational"
+fi
+pass "DDS telemetry across containers: canfleet-top --once on network $net shows 5 nodes OPER"
+
+# ---- socketcand on the host's loopback -----------------------------------------------------------
+# `< hi >` from can0's published port, then a frame in raw mode (socketcand protocol). compose.yaml
+# runs `canfleet up --socketcand-bind 0.0.0.0`: the container's loopback is not where published ports arrive.
+sc_out=$(python3 - "$CANFLEET_CAN0_PORT" <<'PY' 2>&1
+import socket, sys, time
+s = socket.create_connection(("127.0.0.1", int(sys.argv[1])), timeout=10)
+def read():
+    try:
+        return s.recv(4096).decode(errors="replace")
+    except socket.timeout:
+        return ""
+hi = read()
+if "< hi >" not in hi:
+    sys.exit("no '< hi >' (got %r)" % hi)
+s.sendall(b"< open can0 >"); ok = read()
+s.sendall(b"< rawmode >")
+data, end = "", time.time() + 10
+while "< frame " not in data and time.time() < end:
+    data += read()
+if "< frame " not in data:
+    sys.exit("no frame in raw mode (got %r)" % (ok + data)[:200])
+print(data[data.index("< frame "):].split(">")[0] + ">")
+PY
+) && sc_rc=0 || sc_rc=$?
+if [ "$sc_rc" = 0 ]; then
+  pass "socketcand of can0 on 127.0.0.1:$CANFLEET_CAN0_PORT: hi, open can0, rawmode, $sc_out"
+else
+  fail "socketcand of can0 on 127.0.0.1:$CANFLEET_CAN0_PORT: $sc_out"
+fi
+
+container_of() { fleet compose ps -q "$1"; }
+q5=$(container_of quad-5)
+[ -n "$q5" ] || fail "no container for quad-5"
+
+# ---- 3. heartbeat loss, three ways ---------------------------------------------------------------
+loss_and_back() { # METHOD: stop | kill | disconnect
+  local how=$1 c6 c20 t
+  c6=$(node_get quad-6 emcy_count)
+  c20=$(node_get dio-20 emcy_count)
+  t=$(date +%s)
+  case "$how" in
+    stop) docker stop "$q5" >/dev/null ;;
+    kill) docker kill "$q5" >/dev/null ;;
+    disconnect) docker network disconnect "$net" "$q5" ;;
+  esac
+  # 1500 ms consumer time; generous bound for a loaded machine.
+  wait_for 60 "quad-6 EMCY 8130h after docker $how of quad-5" emcy_is quad-6 "$c6" 33072
+  wait_for 60 "dio-20 EMCY 8130h after docker $how of quad-5" emcy_is dio-20 "$c20" 33072
+  local e1003 e1001
+  e1003=$(sdo_u32 quad-6 0x1003 1)
+  expect_eq "quad-6 1003h sub 1 after docker $how of quad-5" "$e1003" 0x08058130
+  e1001=$(sdo_u8 quad-6 0x1001 0)
+  python3 -c 'import sys; sys.exit(0 if int(sys.argv[1]) & 1 else 1)' "$e1001" ||
+    fail "quad-6 error register 1001h = $e1001 after docker $how of quad-5: bit 0 (generic error) not set"
+  wait_for 30 "quad-6 pre-operational after docker $how of quad-5 (1029h sub 1 = 0)" nmt_is quad-6 pre-operational
+  if [ "$how" != disconnect ]; then
+    wait_for 30 "quad-5 detached after docker $how" attached_is quad-5 false
+  fi
+  pass "docker $how quad-5: quad-6 EMCY 8130h, 1003h.1 = $(hex "$e1003"), 1001h = $e1001, pre-operational; dio-20 EMCY 8130h ($(elapsed "$t"))"
+
+  # Back: a fresh boot of quad-5 (configured again by the orchestrator), or the same process
+  # reachable again after a network disconnect.
+  t=$(date +%s)
+  local c6b c5b restarted=0
+  c6b=$(node_get quad-6 emcy_count)
+  c5b=$(node_get quad-5 emcy_count)
+  case "$how" in
+    stop | kill) docker start "$q5" >/dev/null ;;
+    disconnect) docker network connect "$net" "$q5" ;;
+  esac
+  if [ "$how" = disconnect ]; then
+    # The node's TCP connection survives when the container gets its address back; if it does not
+    # (another address, or the broker gave up on it), restart the container.
+    if ! (wait_for 30 "x" emcy_is quad-6 "$c6b" 0) 2>/dev/null; then
+      log "quad-5 did not come back on its own after network connect within 30 s; docker restart"
+      docker restart "$q5" >/dev/null
+      restarted=1
+    fi
+  fi
+  wait_for 90 "quad-6 EMCY 0000h (error reset) after quad-5 is back" emcy_is quad-6 "$c6b" 0
+  local note=""
+  if [ "$how" = disconnect ] && [ "$restarted" = 0 ]; then
+    # Cut off, quad-5 lost quad-7's heartbeat too: its own EMCY 8130h (channel 07h) arrives once it
+    # is reconnected, and 1029h took it to pre-operational; nothing rebooted it.
+    wait_for 30 "quad-5's own EMCY after it was cut off (it consumes quad-7's heartbeat)" \
+      emcy_is_any quad-5 "$c5b"
+    wait_for 30 "quad-5 pre-operational after it was cut off (lost quad-7's heartbeat, 1029h)" \
+      nmt_is quad-5 pre-operational
+    note="same process, TCP session survived; quad-5 itself reported losing quad-7 (EMCY) and went pre-operational"
+  else
+    # A new process: boot-up, configuration by the orchestrator, NMT start by the orchestrator.
+    wait_for 90 "quad-5 operational again after docker $how (configured and started by the orchestrator)" \
+      nmt_is quad-5 operational
+    note="rebooted, configured and started again by the orchestrator"
+  fi
+  expect_eq "quad-5 1016h sub 1 after it came back" "$(sdo_u32 quad-5 0x1016 1)" 0x000705DC
+  expect_eq "quad-5 1017h after it came back" "$(sdo_u16 quad-5 0x1017 0)" 500
+  cli nmt start >/dev/null
+  fleet wait --timeout 90 >/dev/null || fail "not every node operational after NMT start (after docker $how)"
+  pass "quad-5 back after docker $how ($note): 1016h.1 = 000705DCh, 1017h = 500, quad-6 EMCY 0000h; all operational after NMT start ($(elapsed "$t"))"
+}
+
+loss_and_back stop
+loss_and_back kill
+loss_and_back disconnect
+
+log "checked:"
+for c in "${checks[@]}"; do echo "docker-test:   - $c"; done
+for c in "${unchecked[@]}"; do echo "docker-test:   - NOT CHECKED: $c"; done
