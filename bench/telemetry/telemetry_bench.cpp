@@ -144,9 +144,13 @@ long ProcessStatusKb(pid_t pid, const std::string& field) {
   return -1;
 }
 
+/// The Cyclone configuration of every participant of the run (--dds-config): the loopback one by
+/// default; cyclonedds-default.xml (multicast discovery) for 100 processes, see README.md.
+std::string g_dds_config = CANFLEET_DDS_LOOPBACK_CONFIG;
+
 std::vector<std::string> FakeFleet(std::uint32_t domain, std::vector<std::string> extra) {
   std::vector<std::string> args = {CANFLEET_FAKE_FLEET, "--dds-domain", std::to_string(domain),
-                                   "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG};
+                                   "--dds-config", g_dds_config};
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
 }
@@ -166,7 +170,7 @@ long Field(const std::string& text, const std::string& key) {
 /// A monitor that keeps the publishers' data flowing and counts what it receives.
 struct Monitor {
   explicit Monitor(std::uint32_t domain)
-      : participant({.domain_id = domain, .config_file = CANFLEET_DDS_LOOPBACK_CONFIG}),
+      : participant({.domain_id = domain, .config_file = g_dds_config}),
         reader(participant, {.node_status = [this](const auto& s, const auto& m) { OnStatus(s, m); },
                              .emcy = [this](const auto& s, const auto& m) { OnEvent(s.bus, m); },
                              .io = [this](const auto&, const auto& m) { ios += m.valid_data ? 1 : 0; },
@@ -221,7 +225,7 @@ std::string Percentiles(std::vector<std::chrono::system_clock::duration> samples
 }
 
 void CallerCost() {
-  Participant participant({.domain_id = 150, .config_file = CANFLEET_DDS_LOOPBACK_CONFIG});
+  Participant participant({.domain_id = 150, .config_file = g_dds_config});
   NodeTelemetry telemetry(participant, {.bus = "bench", .node_id = 1, .period = 10ms, .min_interval = 20ms});
   NodeStatusSnapshot status;
   status.heartbeat_consumer_count = 16;
@@ -350,19 +354,10 @@ void RealNode(double seconds) {
 
   Monitor monitor(kDomain);
   for (const bool telemetry : {true, false}) {
-    std::vector<std::string> args = {CANFLEET_NODE,
-                                     "--device",
-                                     "quad-controller",
-                                     "--node-id",
-                                     "5",
-                                     "--bus",
-                                     "bench0@" + endpoint,
-                                     "--log-level",
-                                     "warn",
-                                     "--dds-domain",
-                                     std::to_string(kDomain),
-                                     "--dds-config",
-                                     CANFLEET_DDS_LOOPBACK_CONFIG};
+    std::vector<std::string> args = {CANFLEET_NODE, "--device",     "quad-controller",       "--node-id",
+                                     "5",           "--bus",        "bench0@" + endpoint,    "--log-level",
+                                     "warn",        "--dds-domain", std::to_string(kDomain), "--dds-config",
+                                     g_dds_config};
     if (!telemetry) args.push_back("--no-telemetry");
     Child node(args);
     monitor.Run(3s);  // start-up, connection, boot, discovery
@@ -402,6 +397,9 @@ int main(int argc, char** argv) {
   double seconds = 10;
   std::vector<int> publisher_counts{20, 100};
   app.add_option("--seconds", seconds, "measurement time per CPU/latency figure")->capture_default_str();
+  app.add_option("--dds-config", g_dds_config, "Cyclone DDS configuration of every participant")
+      ->check(CLI::ExistingFile)
+      ->capture_default_str();
   app.add_option("--publishers", publisher_counts, "publisher process counts for the latency figures")
       ->capture_default_str();
   std::set<std::string> sections{"caller", "cpu", "latency", "memory", "node"};
