@@ -43,6 +43,19 @@ class FleetFaultsTest : public ::testing::Test {
     ASSERT_TRUE(WaitUntil(
         [&] { return NmtOf("quad-6") == "operational" && NmtOf("quad-5") == "operational"; }, kLong))
         << fleet.Log();
+    // CiA 301 §7.2.8.3.2.2: quad-6's consumer starts at the first heartbeat of quad-5 it receives
+    // after 1016h was written. A heartbeat the orchestrator sees after quad-6 reported operational
+    // (configured, then started) reached quad-6 too: wait for one.
+    const auto since = std::chrono::steady_clock::now();
+    ASSERT_TRUE(WaitUntil(
+        [&] {
+          const auto status = fleet.Status();
+          const auto* producer = fleet.Node(status, "quad-5");
+          const double elapsed_s =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+          return producer->heartbeat_age_s() >= 0 && producer->heartbeat_age_s() < elapsed_s;
+        },
+        kLong));
   }
 
   std::string NmtOf(const std::string& node) const {
