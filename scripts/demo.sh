@@ -7,7 +7,7 @@
 #
 # What you see: `canfleet up` starts the orchestrator (broker, control API) and one process per
 # node; its log (boot-ups, configuration, EMCYs, the scenario's faults) goes to
-# build/demo/orchestrator.log. The terminal shows `canfleet-top`: every node's NMT state,
+# build/demo/orchestrator.log. The terminal shows `canfleet top`: every node's NMT state,
 # controller state, error register and I/O as they publish it over DDS, and the bus load. The
 # demo topology's scenario injects and clears faults while you watch.
 set -euo pipefail
@@ -22,7 +22,7 @@ topology=${1:-topologies/demo.textproto}
 scripts/install-deps.sh
 cmake -S . -B build -G Ninja -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build -j "$(nproc)" --target canfleet canfleet-node canfleet-top
+cmake --build build -j "$(nproc)" --target canfleet canfleet-node
 
 bin=build/bin
 mkdir -p build/demo
@@ -47,6 +47,6 @@ for _ in $(seq 1 600); do
 done
 "$bin/canfleet" status
 echo
-echo "live view (canfleet-top); Ctrl-C stops the demo"
+echo "live view (canfleet top); Ctrl-C stops the demo"
 sleep 2
-"$bin/canfleet-top" || true
+"$bin/canfleet" top || true
