@@ -286,6 +286,11 @@ loss_and_back() { # METHOD: stop | kill | disconnect
       emcy_is_any quad-5 "$c5b"
     wait_for 30 "quad-5 pre-operational after it was cut off (lost quad-7's heartbeat, 1029h)" \
       nmt_is quad-5 pre-operational
+    # The two directions of its TCP session recover separately: the broker's segments to quad-5
+    # may wait out a retransmission back-off of seconds. quad-5's error reset (0000h: quad-7's
+    # heartbeat reached it again) shows that frames reach it again, so an SDO request will too.
+    wait_for 90 "quad-5 receives the bus again after it was cut off (its EMCY 0000h)" \
+      emcy_is quad-5 "$c5b" 0
     note="same process, TCP session survived; quad-5 itself reported losing quad-7 (EMCY) and went pre-operational"
   else
     # A new process: boot-up, configuration by the orchestrator, NMT start by the orchestrator.
