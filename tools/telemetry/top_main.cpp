@@ -1,4 +1,5 @@
-// canfleet-top: `canfleet top` as a program of its own (links DDS only: small, for containers next to a fleet).
+// canfleet-top: `canfleet top` as a program of its own (links DDS only: small, for containers next to a
+// fleet).
 #include <CLI/CLI.hpp>
 
 #include <iostream>

@@ -1,4 +1,5 @@
-// canfleet-watch: `canfleet watch` as a program of its own (links DDS only: small, for containers next to a fleet).
+// canfleet-watch: `canfleet watch` as a program of its own (links DDS only: small, for containers next to a
+// fleet).
 #include <CLI/CLI.hpp>
 
 #include <iostream>

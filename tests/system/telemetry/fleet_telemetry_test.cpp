@@ -35,7 +35,6 @@ std::vector<std::string> DdsArgs(std::uint32_t domain) {
   return {"--dds-domain", std::to_string(domain), "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG};
 }
 
-
 class FleetTelemetry : public ::testing::Test {
  protected:
   static constexpr std::uint32_t kDomain = 90;
