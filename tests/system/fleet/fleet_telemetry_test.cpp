@@ -93,19 +93,15 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
   // manual §4.2) and its NMT change to pre-operational all arrive as DDS samples.
   const auto injected = fleet.Cli({"fault", "inject", "heartbeat-loss", "--node", "quad-1"});
   ASSERT_EQ(injected.exit_code, 0) << injected.err;
-  EXPECT_TRUE(monitor.Until(
-      [&] {
-        return monitor.Has([](const FleetEvent& e) {
-          return e.kind == EventKind::kFault && e.fault && e.fault->kind == "heartbeat-loss" &&
-                 e.fault->action == telemetry::FaultAction::kInjected;
-        });
+  EXPECT_TRUE(monitor.UntilEvent(
+      [](const FleetEvent& e) {
+        return e.kind == EventKind::kFault && e.fault && e.fault->kind == "heartbeat-loss" &&
+               e.fault->action == telemetry::FaultAction::kInjected;
       },
       kFleetPatience));
-  EXPECT_TRUE(monitor.Until(
-      [&] {
-        return monitor.Has([](const FleetEvent& e) {
-          return e.kind == EventKind::kEmcy && e.node_id == 2 && e.emcy && e.emcy->emcy.code == 0x8130;
-        });
+  EXPECT_TRUE(monitor.UntilEvent(
+      [](const FleetEvent& e) {
+        return e.kind == EventKind::kEmcy && e.node_id == 2 && e.emcy && e.emcy->emcy.code == 0x8130;
       },
       kFleetPatience))
       << fleet.NodeLog("quad-2") << fleet.Log();
@@ -117,19 +113,14 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
   // Recovery: the fault is cleared (FaultEvent), the consumer's error resets (EMCY 0000h) and the
   // master starts quad-2 again.
   ASSERT_EQ(fleet.Cli({"fault", "clear", "--all"}).exit_code, 0);
-  EXPECT_TRUE(monitor.Until(
-      [&] {
-        return monitor.Has([](const FleetEvent& e) {
-          return e.kind == EventKind::kFault && e.fault &&
-                 e.fault->action == telemetry::FaultAction::kCleared;
-        });
+  EXPECT_TRUE(monitor.UntilEvent(
+      [](const FleetEvent& e) {
+        return e.kind == EventKind::kFault && e.fault && e.fault->action == telemetry::FaultAction::kCleared;
       },
       kFleetPatience));
-  EXPECT_TRUE(monitor.Until(
-      [&] {
-        return monitor.Has([](const FleetEvent& e) {
-          return e.kind == EventKind::kEmcy && e.node_id == 2 && e.emcy && e.emcy->emcy.code == 0x0000;
-        });
+  EXPECT_TRUE(monitor.UntilEvent(
+      [](const FleetEvent& e) {
+        return e.kind == EventKind::kEmcy && e.node_id == 2 && e.emcy && e.emcy->emcy.code == 0x0000;
       },
       kFleetPatience));
   ASSERT_EQ(fleet.Cli({"nmt", "start", "quad-2"}).exit_code, 0);
@@ -141,9 +132,8 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
                          kFleetPatience))
       << late.view().nodes().size() << " nodes seen by the late reader";
   EXPECT_TRUE(late.Until([&] { return IsOperational(late.Node("can0", 2)); }, kFleetPatience));
-  EXPECT_TRUE(late.Until(
-      [&] { return late.Has([](const FleetEvent& e) { return e.kind == EventKind::kFault && e.replay; }); },
-      kFleetPatience));
+  EXPECT_TRUE(late.UntilEvent([](const FleetEvent& e) { return e.kind == EventKind::kFault && e.replay; },
+                              kFleetPatience));
 }
 
 }  // namespace

@@ -41,6 +41,11 @@ class Monitor {
   bool Has(const std::function<bool(const tools::FleetEvent&)>& match) const {
     return std::any_of(events_.begin(), events_.end(), match);
   }
+  /// Waits until an event matching `match` has arrived.
+  bool UntilEvent(const std::function<bool(const tools::FleetEvent&)>& match,
+                  std::chrono::milliseconds timeout = kPatience) {
+    return Until([&] { return Has(match); }, timeout);
+  }
   const tools::NodeRow* Node(const std::string& bus, std::uint8_t id) const {
     const auto it = view_.nodes().find({bus, id});
     return it == view_.nodes().end() ? nullptr : &it->second;
