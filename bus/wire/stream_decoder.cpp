@@ -31,7 +31,8 @@ std::span<std::uint8_t> StreamDecoder::WritableSpace(std::size_t min) {
       begin_ = 0;
       end_ = buffered;
     }
-    if (buffer_.size() - end_ < want) buffer_.resize(end_ + want);
+    // Uninitialised growth: the socket writes what it reads, and untouched pages cost no memory.
+    if (buffer_.size() - end_ < want) buffer_.Extend(end_ + want - buffer_.size());
   }
   return {buffer_.data() + end_, buffer_.size() - end_};
 }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bus/wire/byte_buffer.hpp"
 #include "bus/wire/messages.hpp"
 
 namespace canfleet::wire {
@@ -50,7 +51,7 @@ class StreamDecoder {
   bool DecodeEnvelope(std::span<const std::uint8_t> body, Message& out);
 
   std::size_t max_message_;
-  std::vector<std::uint8_t> buffer_;
+  ByteBuffer buffer_;
   std::size_t begin_ = 0;   ///< first byte not yet decoded
   std::size_t end_ = 0;     ///< end of received bytes
   std::size_t wanted_ = 0;  ///< size of the partial message at begin_ (prefix included), when known

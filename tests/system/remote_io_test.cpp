@@ -10,6 +10,7 @@
 #include "clock/asio_scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "tests/support/wire_text.hpp"
 #include "tests/system/support/child_process.hpp"
 
 namespace canfleet::system_test {
@@ -92,7 +93,7 @@ TEST_F(RemoteIo, SetAndReadBackAnInputOfARealNodeProcess) {
 
   reply = Ask("quad-5", Get(2, "AIN1.voltage_mV"));
   ASSERT_TRUE(reply);
-  EXPECT_EQ(reply->ShortDebugString(),
+  EXPECT_EQ(test::WireText(*reply),
             R"(request_id: 2 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })");
 
   reply = Ask("quad-5", Set(3, "AIN9.voltage_mV", "3000"));

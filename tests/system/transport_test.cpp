@@ -19,6 +19,7 @@
 #include "clock/asio_scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "tests/support/wire_text.hpp"
 #include "tests/system/support/child_process.hpp"
 
 namespace canfleet::system_test {
@@ -344,7 +345,7 @@ TEST_F(Transport, ANodeRequestReachesTheNamedNodeAndItsReplyComesBack) {
   auto plain = Client(ep, "plain");           // serves no requests
   std::vector<std::string> seen;
   quad->OnNodeRequest([&](const wire::NodeRequest& r) {
-    seen.push_back(r.ShortDebugString());
+    seen.push_back(test::WireText(r));
     wire::NodeReply reply;
     auto* v = reply.add_values();
     v->set_name(r.io_get().name());
@@ -375,7 +376,7 @@ TEST_F(Transport, ANodeRequestReachesTheNamedNodeAndItsReplyComesBack) {
   // Unknown node and unknown bus: nullopt; the others answered (in any order).
   std::vector<std::string> answered;
   for (const auto& r : replies)
-    if (r) answered.push_back(r->ShortDebugString());
+    if (r) answered.push_back(test::WireText(*r));
   ASSERT_EQ(answered.size(), 3u);
   std::sort(answered.begin(), answered.end());
   EXPECT_EQ(answered,

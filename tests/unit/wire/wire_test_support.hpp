@@ -10,6 +10,7 @@
 #include "bus/wire/message_writer.hpp"
 #include "bus/wire/stream_decoder.hpp"
 #include "tests/support/bus_probe.hpp"
+#include "tests/support/wire_text.hpp"
 
 namespace canfleet::wire::test {
 
@@ -39,10 +40,10 @@ inline std::string Describe(const Message& m) {
              std::to_string(m.controller.tec) + " " + std::to_string(m.controller.rec);
       break;
     case MessageType::kHello:
-      out += " " + m.envelope.hello().ShortDebugString();
+      out += " " + canfleet::test::WireText(m.envelope.hello());
       break;
     case MessageType::kHelloReply:
-      out += " " + m.envelope.hello_reply().ShortDebugString();
+      out += " " + canfleet::test::WireText(m.envelope.hello_reply());
       break;
     case MessageType::kPing:
       out += " " + std::to_string(m.envelope.ping().nonce());
@@ -54,10 +55,10 @@ inline std::string Describe(const Message& m) {
       out += " " + m.envelope.error().reason();
       break;
     case MessageType::kNodeRequest:
-      out += " " + m.envelope.node_request().ShortDebugString();
+      out += " " + canfleet::test::WireText(m.envelope.node_request());
       break;
     case MessageType::kNodeReply:
-      out += " " + m.envelope.node_reply().ShortDebugString();
+      out += " " + canfleet::test::WireText(m.envelope.node_reply());
       break;
   }
   return out;
