@@ -94,7 +94,8 @@ std::string WireText(const wire::NodeRequest& m) {
 std::string WireText(const wire::NodeReply& m) {
   TextBuilder text;
   text.Uint("request_id", m.request_id()).String("error", m.error());
-  for (const auto& v : m.values()) text.Message("values", IoValueText(v));
+  for (const auto& v : m.values())
+    text.Message("values", IoValueText(v));
   return text.Take();
 }
 
