@@ -113,6 +113,30 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
   });
   for (const auto& node : nodes_)
     if (!node.external()) supervisor_.Add(node.name(), NodeLaunch(node, options_), PolicyOf(node.spec));
+
+  std::vector<ExternalAdoption::Port> external_ports;
+  for (const auto& node : nodes_)
+    if (node.external())
+      for (std::size_t p = 0; p < node.buses.size(); ++p)
+        external_ports.push_back({node.name(), node.buses[p], node.node_ids[p]});
+  adoption_ = std::make_unique<ExternalAdoption>(
+      ExternalAdoption::Context{
+          .scheduler = scheduler_,
+          .attached =
+              [this](const std::string& bus, const std::string& name) {
+                for (const auto& port : broker_.Ports(bus))
+                  if (port.name == name) return true;
+                return false;
+              },
+          .booted =
+              [this](const std::string& bus, std::uint8_t id) {
+                const NodeLiveState* live = tracker_.Find(bus, id);
+                return live && live->booted;
+              },
+          .reset_communication =
+              [this](const ExternalAdoption::Port& port) { SendNmt(port.bus, 0x82, port.node_id); },
+      },
+      std::move(external_ports));
 }
 
 Fleet::~Fleet() = default;
@@ -123,6 +147,7 @@ void Fleet::Start() {
   for (const auto& node : nodes_)
     if (node.external()) spdlog::info("{}: external, waiting for it to attach", node.name());
   if (options_.start_processes) supervisor_.StartAll();
+  adoption_->Start();
 }
 
 void Fleet::Stop(std::function<void()> done) {

@@ -17,6 +17,7 @@
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/control/control_handler.hpp"
+#include "orchestrator/fleet/external_adoption.hpp"
 #include "orchestrator/fleet/fault_manager.hpp"
 #include "orchestrator/fleet/fleet_node.hpp"
 #include "orchestrator/fleet/frame_feed.hpp"
@@ -104,6 +105,7 @@ class Fleet final : public control::ControlHandler {
   NodeTracker tracker_;
   Supervisor supervisor_;
   std::unique_ptr<FaultManager> faults_;
+  std::unique_ptr<ExternalAdoption> adoption_;  ///< running external nodes that attach without a boot-up
   Captures captures_;
   std::vector<std::unique_ptr<Timer>> scenario_timers_;
   bool ready_ = false;

@@ -48,14 +48,14 @@ bool ParseJson(const std::string& json, google::protobuf::Message& message, std:
   return status.ok();
 }
 
-FleetUnderTest::FleetUnderTest(const std::string& topology) {
+FleetUnderTest::FleetUnderTest(const std::string& topology, const std::string& listen) {
   // The fleet's nodes publish telemetry; keep it off other tests' DDS domain.
   ::setenv("CANFLEET_DDS_DOMAIN", "76", 0);
   const std::string file = dir_.File("fleet.textproto");
   std::ofstream(file) << topology;
   up_ = std::make_unique<ChildProcess>(
       std::vector<std::string>{PROGRAM_CANFLEET, "up", file, "--control", "tcp://127.0.0.1:0", "--listen",
-                               "tcp://127.0.0.1:0", "--ready-file", dir_.File("ready"), "--node-binary",
+                               listen, "--ready-file", dir_.File("ready"), "--node-binary",
                                PROGRAM_CANFLEET_NODE, "--log-level", "debug"},
       dir_.File("orchestrator.log"));
   WaitUntil(

@@ -26,8 +26,9 @@ CliResult RunCanfleet(const std::vector<std::string>& args);
 
 class FleetUnderTest {
  public:
-  /// Writes `topology` (text format) as DIR/fleet.textproto and starts `canfleet up` on it.
-  explicit FleetUnderTest(const std::string& topology);
+  /// Writes `topology` (text format) as DIR/fleet.textproto and starts `canfleet up` on it, its
+  /// broker listening on `listen` (default: a port the kernel picks).
+  explicit FleetUnderTest(const std::string& topology, const std::string& listen = "tcp://127.0.0.1:0");
   /// SIGTERM to the orchestrator; waits for it; checks no node process is left.
   ~FleetUnderTest();
 

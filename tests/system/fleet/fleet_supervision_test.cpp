@@ -197,6 +197,21 @@ TEST(FleetFrames, DumpAndCaptureShowTheBusTraffic) {
   EXPECT_EQ(static_cast<unsigned char>(bytes[20]), 227u);  // LINKTYPE_CAN_SOCKETCAN
 }
 
+// The broker endpoint the fleet's ready file names (written once the buses listen).
+std::string BrokerEndpoint(const FleetUnderTest& fleet) {
+  std::string broker;
+  WaitUntil(
+      [&] {
+        std::ifstream in(fleet.dir().File("ready"));
+        std::string key, value;
+        while (in >> key >> value)
+          if (key == "broker") broker = value;
+        return !broker.empty();
+      },
+      kLong);
+  return broker;
+}
+
 // A node started elsewhere (another host, a container) attaches by name: the orchestrator
 // configures it after its boot-up like its own, and reaches its simulated I/O over its broker
 // connection.
@@ -208,16 +223,8 @@ node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" }
 node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" external: true
        heartbeat { producer_ms: 300 } }
 )");
-  std::string broker;
-  ASSERT_TRUE(WaitUntil(
-      [&] {
-        std::ifstream in(fleet.dir().File("ready"));
-        std::string key, value;
-        while (in >> key >> value)
-          if (key == "broker") broker = value;
-        return !broker.empty();
-      },
-      kLong));
+  const std::string broker = BrokerEndpoint(fleet);
+  ASSERT_FALSE(broker.empty()) << fleet.Log();
   const auto before = fleet.Status();
   EXPECT_EQ(fleet.Node(before, "remote-8")->process(), "external");
   EXPECT_FALSE(fleet.Node(before, "remote-8")->attached());
@@ -239,6 +246,46 @@ node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" externa
   EXPECT_EQ(fleet.IoGet("remote-8", "AIN1.voltage_mV"), "2500");
   // Its process is not ours to kill.
   EXPECT_EQ(fleet.Cli({"fault", "inject", "kill", "--node", "remote-8"}).exit_code, 1);
+}
+
+// An external node keeps running while the orchestrator restarts (its container restarted, say).
+// It reconnects to the new broker without a boot-up; the new orchestrator sends it NMT reset
+// communication (orchestrator/fleet/external_adoption.hpp), so that it boots up and is configured
+// from the new topology like a node that had just started.
+TEST(FleetSupervision, RestartedOrchestratorAdoptsARunningExternalNode) {
+  const auto topology = [](int heartbeat_ms) {
+    return R"(
+name: "fleet-test"
+bus { name: "can0" bitrate: 500000 }
+node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" external: true
+       heartbeat { producer_ms: )" +
+           std::to_string(heartbeat_ms) + " } }\n";
+  };
+  TempDir dir;
+  auto first = std::make_unique<FleetUnderTest>(topology(300));
+  const std::string broker = BrokerEndpoint(*first);
+  ASSERT_FALSE(broker.empty()) << first->Log();
+  ChildProcess remote({PROGRAM_CANFLEET_NODE, "--device", "quad-controller", "--node-id", "8", "--name",
+                       "remote-8", "--bus", "can0@" + broker, "--no-telemetry"},
+                      dir.File("remote-8.log"));
+  ASSERT_TRUE(first->WaitReady()) << first->Log();
+  EXPECT_EQ(first->SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 300u);
+
+  first.reset();  // SIGTERM: the orchestrator and its broker go, remote-8 keeps running
+  ASSERT_TRUE(remote.Running()) << remote.Log();
+  FleetUnderTest second(topology(700), broker);
+  ASSERT_TRUE(second.WaitReady()) << second.Log() << remote.Log();
+  EXPECT_NE(second.Log().find("without a boot-up"), std::string::npos) << second.Log();
+  EXPECT_TRUE(remote.Running()) << "the same process was adopted, not a new one";
+  EXPECT_EQ(second.SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 700u) << second.Log();
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        const auto status = second.Status();
+        const auto* n = second.Node(status, "remote-8");
+        return n->attached() && n->booted() && n->nmt_state() == "operational";
+      },
+      kLong))
+      << second.Log();
 }
 
 // The topology's scenario runs on its own once the fleet is ready: inject, then clear by label.
