@@ -2,7 +2,7 @@
 # scripts/install-deps.sh installs them.
 find_package(Threads REQUIRED)
 # Targets link spdlog::spdlog_header_only, not the compiled libspdlog: a node process then
-# carries only the logging code it uses instead of loading all of libspdlog (0.4 MB less RSS per
+# carries only the logging code it uses instead of loading all of libspdlog (0.3 MB less RSS per
 # node, issue 7). All targets must use the same one (the header-only build defines the functions
 # inline; mixing the two in one program would break the one-definition rule).
 find_package(spdlog REQUIRED)
