@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <span>
 #include <string>
-#include <vector>
 
 #include "bus/wire/byte_buffer.hpp"
 #include "bus/wire/messages.hpp"

@@ -80,6 +80,13 @@ std::vector<PortStats> Broker::Ports(std::string_view bus) const {
   return out;
 }
 
+std::optional<PortId> Broker::NewestPortNamed(std::string_view bus, std::string_view name) const {
+  std::optional<PortId> found;
+  for (const detail::Port* p : FindBus(bus).Ports())
+    if (p->name == name) found = p->id;  // attach order: the last one is the newest
+  return found;
+}
+
 std::vector<std::string> Broker::Buses() const {
   std::vector<std::string> names;
   for (const auto& bus : buses_)

@@ -8,6 +8,7 @@
 /// that scheduler's event loop; sinks are called from there too.
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -85,6 +86,9 @@ class Broker {
   PortStats Port(PortId port) const;
   /// Every attached port of a bus, in attach order. Throws on an unknown bus.
   std::vector<PortStats> Ports(std::string_view bus) const;
+  /// The newest attached port of `bus` called `name` (a node that reconnects may briefly have
+  /// two), or nullopt. Throws on an unknown bus.
+  std::optional<PortId> NewestPortNamed(std::string_view bus, std::string_view name) const;
   /// Bus names in the order they were added.
   std::vector<std::string> Buses() const;
 

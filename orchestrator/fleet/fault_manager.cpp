@@ -57,9 +57,7 @@ const FleetNode& FaultManager::Node(const std::string& name) const {
 }
 
 broker::PortId FaultManager::PortOf(const std::string& bus, const std::string& node) const {
-  std::optional<broker::PortId> found;
-  for (const auto& port : ctx_.broker.Ports(bus))
-    if (port.name == node) found = port.id;  // the newest attachment wins
+  const std::optional<broker::PortId> found = ctx_.broker.NewestPortNamed(bus, node);
   if (!found) throw FaultError("node '" + node + "' is not attached to bus " + bus + " right now");
   return *found;
 }

@@ -122,12 +122,9 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
   adoption_ = std::make_unique<ExternalAdoption>(
       ExternalAdoption::Context{
           .scheduler = scheduler_,
-          .attached =
-              [this](const std::string& bus, const std::string& name) {
-                for (const auto& port : broker_.Ports(bus))
-                  if (port.name == name) return true;
-                return false;
-              },
+          .attached = [this](
+                          const std::string& bus,
+                          const std::string& name) { return broker_.NewestPortNamed(bus, name).has_value(); },
           .booted =
               [this](const std::string& bus, std::uint8_t id) {
                 const NodeLiveState* live = tracker_.Find(bus, id);

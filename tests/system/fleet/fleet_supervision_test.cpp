@@ -212,6 +212,17 @@ std::string BrokerEndpoint(const FleetUnderTest& fleet) {
   return broker;
 }
 
+// Waits until the orchestrator reports `node` attached, booted and operational.
+bool WaitAttachedAndOperational(const FleetUnderTest& fleet, const std::string& node) {
+  return WaitUntil(
+      [&] {
+        const auto status = fleet.Status();
+        const auto* n = fleet.Node(status, node);
+        return n->attached() && n->booted() && n->nmt_state() == "operational";
+      },
+      kLong);
+}
+
 // A node started elsewhere (another host, a container) attaches by name: the orchestrator
 // configures it after its boot-up like its own, and reaches its simulated I/O over its broker
 // connection.
@@ -233,14 +244,7 @@ node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" externa
                        "remote-8", "--bus", "can0@" + broker, "--no-telemetry"},
                       fleet.dir().File("remote-8.log"));
   ASSERT_TRUE(fleet.WaitReady()) << fleet.Log();
-  EXPECT_TRUE(WaitUntil(
-      [&] {
-        const auto status = fleet.Status();
-        const auto* n = fleet.Node(status, "remote-8");
-        return n->attached() && n->booted() && n->nmt_state() == "operational";
-      },
-      kLong))
-      << fleet.Log();
+  EXPECT_TRUE(WaitAttachedAndOperational(fleet, "remote-8")) << fleet.Log();
   EXPECT_EQ(fleet.SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 300u);  // configured by the orchestrator
   ASSERT_EQ(fleet.Cli({"io", "set", "remote-8", "AIN1.voltage_mV", "2500"}).exit_code, 0);
   EXPECT_EQ(fleet.IoGet("remote-8", "AIN1.voltage_mV"), "2500");
@@ -278,14 +282,7 @@ node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" externa
   EXPECT_NE(second.Log().find("without a boot-up"), std::string::npos) << second.Log();
   EXPECT_TRUE(remote.Running()) << "the same process was adopted, not a new one";
   EXPECT_EQ(second.SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 700u) << second.Log();
-  EXPECT_TRUE(WaitUntil(
-      [&] {
-        const auto status = second.Status();
-        const auto* n = second.Node(status, "remote-8");
-        return n->attached() && n->booted() && n->nmt_state() == "operational";
-      },
-      kLong))
-      << second.Log();
+  EXPECT_TRUE(WaitAttachedAndOperational(second, "remote-8")) << second.Log();
 }
 
 // The topology's scenario runs on its own once the fleet is ready: inject, then clear by label.
