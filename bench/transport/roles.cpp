@@ -71,28 +71,36 @@ int RunBrokerClient(const ClientConfig& c) {
     StoreTime(MonotonicNs(), f.data.data());
     return port.Send(f);
   };
+  // The window, kept without a division per frame: every `others` frames received allow one more.
+  std::uint64_t allowed = c.window;
+  std::uint64_t toward_next = 0;
   auto pump = [&] {
-    const std::uint64_t allowed = received / others + c.window + extra;
-    while (sent < allowed) {
+    while (sent < allowed + extra) {
       if (!send_one()) break;
       ++sent;
     }
   };
-  // The clock is read once per io_context turn (the frames of one socket read), as the raw node
-  // reads it once per recv: per-frame clock reads would cost more than the transport itself.
+  // The clock is read once per socket read (the frames of one batch), as the raw node reads it
+  // once per recv: per-frame clock reads would cost more than the transport itself. The port
+  // writes what the node sent while a batch was delivered in one write when the batch is done, as
+  // the raw node sends once per recv.
+  const BrokerClientStats& port_stats = port.Stats();  // stays valid while the port lives
+  std::uint64_t seen_reads = 0;
   std::int64_t turn_now = 0;
-  bool turn_now_valid = false;
   port.OnReceive([&](const CanFrame& f, BusTime) {
-    if (!turn_now_valid) {
+    if (port_stats.reads != seen_reads) {
+      seen_reads = port_stats.reads;
       turn_now = MonotonicNs();
-      turn_now_valid = true;
-      asio::post(io, [&] { turn_now_valid = false; });
     }
     const std::int64_t now = turn_now;
     ++received;
     if (now >= window.start && now < window.end) {
       ++in_window;
       histogram.Add(now - LoadTime(f.data.data()));
+    }
+    if (++toward_next == others) {
+      toward_next = 0;
+      ++allowed;
     }
     if (going && !c.latency && now < window.stop) pump();
   });

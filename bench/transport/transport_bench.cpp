@@ -60,6 +60,16 @@ const char* Name(Path path) {
   return "?";
 }
 
+/// CANFLEET_BENCH_PATHS (e.g. "unix" or "raw,tcp") limits a run to some paths, for profiling one
+/// of them alone; "vs raw" is then empty unless raw runs too.
+bool Selected(Path path) {
+  const char* list = std::getenv("CANFLEET_BENCH_PATHS");
+  if (list == nullptr || *list == '\0') return true;
+  const std::string paths = std::string(",") + list + ",";
+  const char* key = path == Path::kRaw ? ",raw," : path == Path::kUnix ? ",unix," : ",tcp,";
+  return paths.find(key) != std::string::npos;
+}
+
 struct Options {
   double seconds = 2;
   std::vector<int> ports = {2, 8, 32};
@@ -70,6 +80,7 @@ struct Options {
 struct Result {
   double deliveries_per_s = 0;
   double server_cpu = 0;  ///< broker or relay CPU, fraction of one core, over the window
+  double nodes_cpu = 0;   ///< all node processes together, fraction of one core, over the window
   LatencyHistogram latency;
   std::uint64_t kicks = 0;
   std::uint64_t writes = 0;  ///< client socket writes (broker clients)
@@ -139,10 +150,18 @@ Result Run(Path path, int ports, bool latency, const Options& o) {
   auto sleep_until = [](std::int64_t ns) {
     std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(ns)));
   };
+  auto nodes_cpu = [&] {
+    std::chrono::duration<double> total{0};
+    for (auto& c : clients)
+      total += c->CpuTime();
+    return total;
+  };
   sleep_until(start);
   const auto cpu_start = server->CpuTime();
+  const auto nodes_start = nodes_cpu();
   sleep_until(end);
   const auto cpu_end = server->CpuTime();
+  const auto nodes_end = nodes_cpu();
 
   Result r;
   std::uint64_t rx = 0;
@@ -164,6 +183,7 @@ Result Run(Path path, int ports, bool latency, const Options& o) {
   server->Stop();
   r.deliveries_per_s = static_cast<double>(rx) / o.seconds;
   r.server_cpu = (cpu_end - cpu_start).count() / o.seconds;
+  r.nodes_cpu = (nodes_end - nodes_start).count() / o.seconds;
   return r;
 }
 
@@ -196,24 +216,28 @@ int Driver(const Options& o) {
       "%.1f s per measurement, window %zu frames per node, light load = %.0f frames/s from one node\n",
       o.seconds, o.window, o.rate);
   std::printf(
-      "server CPU: broker (or relay) CPU time / wall time; ns/delivery: that CPU time per delivery\n\n");
+      "server CPU: broker (or relay) CPU time / wall time; ns/delivery: that CPU time per delivery;\n"
+      "node ns/delivery: the CPU time of all node processes together per delivery\n\n");
   std::printf(
       "| path              | ports | deliveries/s | frames/s  | vs raw | server CPU | ns/delivery |"
-      " p50 us | p99 us | loaded p50 us | loaded p99 us |\n");
+      " node ns/delivery | p50 us | p99 us | loaded p50 us | loaded p99 us |\n");
   std::printf(
       "|-------------------|------:|-------------:|----------:|-------:|-----------:|------------:|"
-      "-------:|-------:|--------------:|--------------:|\n");
+      "-----------------:|-------:|-------:|--------------:|--------------:|\n");
   for (int ports : o.ports) {
     double raw = 0;
     for (Path path : {Path::kRaw, Path::kUnix, Path::kTcp}) {
+      if (!Selected(path)) continue;
       const Result t = Run(path, ports, false, o);
       const Result l = Run(path, ports, true, o);
       if (path == Path::kRaw) raw = t.deliveries_per_s;
       std::printf(
-          "| %-17s | %5d | %12.0f | %9.0f | %5.0f%% | %9.0f%% | %11.0f | %6.1f | %6.1f | %13.1f | %13.1f |\n",
+          "| %-17s | %5d | %12.0f | %9.0f | %5.0f%% | %9.0f%% | %11.0f | %16.0f | %6.1f | %6.1f | %13.1f | "
+          "%13.1f |\n",
           Name(path), ports, t.deliveries_per_s, t.deliveries_per_s / (ports - 1),
           raw > 0 ? 100 * t.deliveries_per_s / raw : 0, 100 * t.server_cpu,
-          t.deliveries_per_s > 0 ? 1e9 * t.server_cpu / t.deliveries_per_s : 0, l.latency.Percentile(0.5),
+          t.deliveries_per_s > 0 ? 1e9 * t.server_cpu / t.deliveries_per_s : 0,
+          t.deliveries_per_s > 0 ? 1e9 * t.nodes_cpu / t.deliveries_per_s : 0, l.latency.Percentile(0.5),
           l.latency.Percentile(0.99), t.latency.Percentile(0.5), t.latency.Percentile(0.99));
       if (t.kicks != 0)
         std::printf(

@@ -14,6 +14,7 @@
 
 #include "bus/wire/endpoint.hpp"
 #include "bus/wire/message_writer.hpp"
+#include "bus/wire/socket_io.hpp"
 #include "bus/wire/stream_decoder.hpp"
 
 namespace canfleet {
@@ -23,9 +24,6 @@ namespace {
 /// Bytes asked of the socket per read: many batches at once under load.
 constexpr std::size_t kReadChunk = 64 * 1024;
 
-asio::mutable_buffer Buffer(std::span<std::uint8_t> s) {
-  return {s.data(), s.size()};
-}
 asio::const_buffer Buffer(std::span<const std::uint8_t> s) {
   return {s.data(), s.size()};
 }
@@ -138,34 +136,67 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
                                         options_.monitor ? wire::ROLE_MONITOR : wire::ROLE_NODE);
     hello.set_tx_confirmations(options_.tx_confirmations);
     filling_.AddHello(hello);
+    const std::uint64_t gen = generation_;
     Flush();
+    if (gen != generation_) return;  // the write failed: Fail() has scheduled the next attempt
     Read();
   }
 
+  /// One read, then (once the socket is drained) a wait for readiness (bus/wire/socket_io.hpp):
+  /// no recv is made only to learn that nothing is left. The wait is armed in the handler whose
+  /// read found the socket drained, so data arriving later always finds it.
   void Read() {
     const std::uint64_t gen = generation_;
-    socket_.async_read_some(
-        Buffer(decoder_.WritableSpace(kReadChunk)),
-        [this, self = shared_from_this(), gen](const asio::error_code& ec, std::size_t n) {
-          if (gen != generation_) return;
-          if (ec) {
-            Fail(ec == asio::error::eof ? "the broker closed the connection" : ec.message());
-            return;
-          }
-          ++stats_.reads;
-          decoder_.Commit(n);
-          for (;;) {
-            const auto result = decoder_.Next(message_);
-            if (result == wire::StreamDecoder::Result::kNeedMore) break;
-            if (result == wire::StreamDecoder::Result::kError) {
-              ProtocolError("malformed data from the broker: " + decoder_.Error());
-              return;
-            }
-            Handle(message_);
-            if (gen != generation_) return;  // the handler failed or destroyed the port
-          }
-          Read();
-        });
+    const std::span<std::uint8_t> space = decoder_.WritableSpace(kReadChunk);
+    std::error_code ec;
+    const std::size_t n = wire::ReceiveNow(socket_.native_handle(), space, ec);
+    ++stats_.reads;
+    if (wire::WouldBlock(ec)) {
+      ++stats_.empty_reads;
+      WaitReadable();
+      return;
+    }
+    if (ec) {
+      Fail(ec == wire::EndOfStream() ? "the broker closed the connection" : ec.message());
+      return;
+    }
+    decoder_.Commit(n);
+    reading_ = true;
+    for (;;) {
+      const auto result = decoder_.Next(message_);
+      if (result == wire::StreamDecoder::Result::kNeedMore) break;
+      if (result == wire::StreamDecoder::Result::kError) {
+        reading_ = false;
+        ProtocolError("malformed data from the broker: " + decoder_.Error());
+        return;
+      }
+      Handle(message_);
+      if (gen != generation_) return;  // the handler failed or destroyed the port
+    }
+    reading_ = false;
+    Flush();
+    if (gen != generation_) return;  // the write failed
+    if (n < space.size()) {
+      WaitReadable();
+      return;
+    }
+    // A full chunk: more may be waiting; read it after the handlers already queued (timers).
+    asio::post(io_, [this, self = shared_from_this(), gen] {
+      if (gen == generation_) Read();
+    });
+  }
+
+  void WaitReadable() {
+    const std::uint64_t gen = generation_;
+    socket_.async_wait(asio::socket_base::wait_read,
+                       [this, self = shared_from_this(), gen](const asio::error_code& ec) {
+                         if (gen != generation_) return;
+                         if (ec) {
+                           Fail(ec.message());
+                           return;
+                         }
+                         Read();
+                       });
   }
 
   void Handle(const wire::Message& m) {
@@ -312,13 +343,17 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
     socket_.close(ignored);
     // Pending operations were cancelled with the socket: the buffers are free again.
     write_in_flight_ = false;
+    reading_ = false;
     filling_.Clear();
     writing_.Clear();
     decoder_ = wire::StreamDecoder();
   }
 
   void ScheduleFlush() {
-    if (flush_posted_ || write_in_flight_) return;
+    // Inside a read handler (frames being delivered), the read flushes when its batch is done:
+    // what the node answers to one batch leaves in one write, without a posted handler (which
+    // would also cost the event loop an extra epoll_wait before running it).
+    if (flush_posted_ || write_in_flight_ || reading_) return;
     flush_posted_ = true;
     asio::post(io_, [this, self = shared_from_this()] {
       flush_posted_ = false;
@@ -326,20 +361,36 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
     });
   }
 
-  /// Writes everything appended so far in one write; what is appended meanwhile waits for it.
+  /// Writes everything appended so far in one write, straight away; what the socket does not take
+  /// is written asynchronously, and what is appended meanwhile waits for it.
   void Flush() {
     if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
-    filling_.Swap(writing_);
-    write_in_flight_ = true;
+    const std::span<const std::uint8_t> bytes = filling_.Bytes();
+    const iovec buffer{const_cast<std::uint8_t*>(bytes.data()), bytes.size()};
+    std::error_code ec;
+    const std::size_t sent = wire::SendNow(socket_.native_handle(), {&buffer, 1}, ec);
     ++stats_.writes;
+    if (ec && !wire::WouldBlock(ec)) {
+      Fail(ec.message());
+      return;
+    }
+    if (sent == bytes.size()) {
+      filling_.Clear();
+      return;
+    }
+    ++stats_.partial_writes;
+    writing_.Clear();
+    writing_.AddEncoded(bytes.data() + sent, bytes.size() - sent);
+    filling_.Clear();
+    write_in_flight_ = true;
     const std::uint64_t gen = generation_;
     asio::async_write(socket_, Buffer(writing_.Bytes()),
-                      [this, self = shared_from_this(), gen](const asio::error_code& ec, std::size_t) {
+                      [this, self = shared_from_this(), gen](const asio::error_code& write_ec, std::size_t) {
                         if (gen != generation_) return;
                         write_in_flight_ = false;
                         writing_.Clear();
-                        if (ec) {
-                          Fail(ec.message());
+                        if (write_ec) {
+                          Fail(write_ec.message());
                           return;
                         }
                         Flush();
@@ -360,9 +411,10 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
   wire::StreamDecoder decoder_;
   wire::Message message_;
   wire::MessageWriter filling_;  ///< appended to by Send and replies
-  wire::MessageWriter writing_;  ///< being written
+  wire::MessageWriter writing_;  ///< the unwritten rest of a write the socket took only in part
   bool write_in_flight_ = false;
   bool flush_posted_ = false;
+  bool reading_ = false;  ///< delivering the messages of one read; it flushes when done
 
   ControllerState state_ = ControllerState::kErrorActive;
   BrokerSession session_;

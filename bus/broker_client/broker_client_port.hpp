@@ -47,11 +47,13 @@ struct BrokerClientStats {
   std::uint64_t connects = 0;     ///< accepted Hellos
   std::uint64_t disconnects = 0;  ///< established connections lost
   std::uint64_t failed_attempts = 0;
-  std::uint64_t tx_frames = 0;   ///< frames accepted by Send
-  std::uint64_t tx_refused = 0;  ///< Send returned false
-  std::uint64_t rx_frames = 0;   ///< frames delivered to OnReceive
-  std::uint64_t writes = 0;      ///< socket writes started (one per io_context turn at most)
-  std::uint64_t reads = 0;       ///< socket reads completed
+  std::uint64_t tx_frames = 0;       ///< frames accepted by Send
+  std::uint64_t tx_refused = 0;      ///< Send returned false
+  std::uint64_t rx_frames = 0;       ///< frames delivered to OnReceive
+  std::uint64_t writes = 0;          ///< socket writes (one per io_context turn at most)
+  std::uint64_t partial_writes = 0;  ///< of those, taken only in part by the socket
+  std::uint64_t reads = 0;           ///< socket reads
+  std::uint64_t empty_reads = 0;     ///< of those, found nothing to read (EAGAIN)
 };
 
 /// A BusPort on a broker's virtual bus, over TCP or a Unix-domain socket, driven by an

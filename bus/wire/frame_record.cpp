@@ -49,16 +49,6 @@ bool ValidateRecord(const std::uint8_t* record, std::string& error) {
   return true;
 }
 
-StampedFrame DecodeRecord(const std::uint8_t* record) {
-  StampedFrame out;
-  out.time = BusTime(LoadLittle<std::int64_t>(record));
-  out.frame.id = LoadLittle<std::uint32_t>(record + 8);
-  out.frame.dlc = record[12];
-  out.frame.flags = record[13];
-  std::memcpy(out.frame.data.data(), record + 16, 8);
-  return out;
-}
-
 namespace {
 
 /// The common case of ValidateRecord, branch-light and without building a message.

@@ -57,8 +57,26 @@ inline void EncodeRecord(const CanFrame& frame, BusTime time, std::uint8_t* out)
 /// Checks one record; on failure returns false and says why in `error`.
 bool ValidateRecord(const std::uint8_t* record, std::string& error);
 
-/// Reads one record that ValidateRecord accepted.
-StampedFrame DecodeRecord(const std::uint8_t* record);
+/// Reads one record that ValidateRecord accepted. Inline: it runs once per frame and receiver.
+inline StampedFrame DecodeRecord(const std::uint8_t* record) {
+  StampedFrame out;
+  std::int64_t ns = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(&ns, record, 8);
+    std::memcpy(&out.frame.id, record + 8, 4);
+  } else {
+    for (std::size_t i = 0; i < 8; ++i)
+      ns |= static_cast<std::int64_t>(static_cast<std::uint64_t>(record[i]) << (8 * i));
+    out.frame.id = 0;
+    for (std::size_t i = 0; i < 4; ++i)
+      out.frame.id |= static_cast<std::uint32_t>(record[8 + i]) << (8 * i);
+  }
+  out.time = BusTime(ns);
+  out.frame.dlc = record[12];
+  out.frame.flags = record[13];
+  std::memcpy(out.frame.data.data(), record + 16, 8);
+  return out;
+}
 
 /// A validated run of records (a view: the bytes belong to someone else).
 class FrameRecords {

@@ -15,11 +15,11 @@ constexpr std::uint8_t kTagEnvelopeFrames = (3 << 3) | 2;
 constexpr std::uint8_t kTagEnvelopeTxConfirm = (4 << 3) | 2;
 constexpr std::uint8_t kTagBatchRecords = (1 << 3) | 2;
 
-/// Header of a batch at its largest: three varints of at most 3 bytes (a batch is < 2^21 bytes)
-/// and two tags.
+/// Header of a batch at its largest (wire::kMaxBatchHeader): three varints of at most 3 bytes
+/// (a batch is < 2^21 bytes) and two tags.
 constexpr std::size_t kMaxBatchRecordsBytes = kMaxFramesPerMessage * kFrameRecordSize;
-constexpr std::size_t kMaxBatchHeader = 3 + 1 + 3 + 1 + 3;
 static_assert(VarintSize(kMaxBatchRecordsBytes + 16) <= 3);
+static_assert(3 + 1 + 3 + 1 + 3 <= kMaxBatchHeader);
 
 /// The header of a batch of `records` bytes: Envelope length, tag, FrameBatch length, tag,
 /// records length.
@@ -50,16 +50,8 @@ void MessageWriter::CloseBatch() {
     buffer_.Shrink(batch_start_);
     return;
   }
-  // Envelope { frames|tx_confirm: FrameBatch { records: <records> } }, length-prefixed.
-  const std::size_t inner = 1 + VarintSize(records) + records;
-  const std::size_t envelope = 1 + VarintSize(inner) + inner;
   std::uint8_t header[kMaxBatchHeader];
-  std::uint8_t* p = WriteVarint(envelope, header);
-  *p++ = batch_kind_ == MessageType::kTxConfirm ? kTagEnvelopeTxConfirm : kTagEnvelopeFrames;
-  p = WriteVarint(inner, p);
-  *p++ = kTagBatchRecords;
-  p = WriteVarint(records, p);
-  const auto header_size = static_cast<std::size_t>(p - header);
+  const std::size_t header_size = WriteBatchHeader(batch_kind_, batch_frames_, header);
   if (header_size < batch_header_) {
     std::uint8_t* start = buffer_.data() + batch_start_;
     std::memmove(start + header_size, start + batch_header_, records);
@@ -70,6 +62,24 @@ void MessageWriter::CloseBatch() {
     std::memmove(start + header_size, start + batch_header_, records);
   }
   std::memcpy(buffer_.data() + batch_start_, header, header_size);
+}
+
+std::size_t WriteBatchHeader(MessageType kind, std::size_t frames, std::uint8_t* out) {
+  // Envelope { frames|tx_confirm: FrameBatch { records: <records> } }, length-prefixed.
+  const std::size_t records = frames * kFrameRecordSize;
+  const std::size_t inner = 1 + VarintSize(records) + records;
+  const std::size_t envelope = 1 + VarintSize(inner) + inner;
+  std::uint8_t* p = WriteVarint(envelope, out);
+  *p++ = kind == MessageType::kTxConfirm ? kTagEnvelopeTxConfirm : kTagEnvelopeFrames;
+  p = WriteVarint(inner, p);
+  *p++ = kTagBatchRecords;
+  p = WriteVarint(records, p);
+  return static_cast<std::size_t>(p - out);
+}
+
+void MessageWriter::AddEncoded(const std::uint8_t* bytes, std::size_t size) {
+  CloseBatch();
+  if (size != 0) std::memcpy(buffer_.Extend(size), bytes, size);
 }
 
 template <class Fill>

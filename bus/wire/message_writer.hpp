@@ -14,6 +14,16 @@
 
 namespace canfleet::wire {
 
+/// Bytes of the largest frames-batch header (WriteBatchHeader).
+inline constexpr std::size_t kMaxBatchHeader = 11;
+
+/// Writes at `out` (kMaxBatchHeader bytes of room) the start of a length-delimited Envelope that
+/// holds one batch of `frames` records of `kind` (kFrames or kTxConfirm), byte-identical to what
+/// MessageWriter writes; the `frames` records (EncodeRecord) follow it on the wire. Returns its
+/// size. `frames` is 1..kMaxFramesPerMessage. Lets a writer send records it did not copy (the
+/// broker's round encoding, shared by every session) behind a header of its own.
+std::size_t WriteBatchHeader(MessageType kind, std::size_t frames, std::uint8_t* out);
+
 /// Appends length-delimited Envelopes (canfleet_wire.proto) to a buffer.
 ///
 /// Frames go into an open batch: consecutive frames of the same kind extend one FrameBatch message
@@ -78,6 +88,9 @@ class MessageWriter {
   void AddError(std::string_view reason);
   void AddNodeRequest(const NodeRequest& request);
   void AddNodeReply(const NodeReply& reply);
+  /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write
+  /// that went to the socket only in part), after closing the open batch.
+  void AddEncoded(const std::uint8_t* bytes, std::size_t size);
 
   /// Closes the open batch, if any.
   void CloseBatch();

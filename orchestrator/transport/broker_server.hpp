@@ -47,6 +47,11 @@ struct ServerStats {
   std::uint64_t backlog_drops = 0;    ///< frames not sent to slow readers
   std::uint64_t node_requests = 0;    ///< RequestNode calls
   std::uint64_t node_replies = 0;     ///< of those, answered by the node (error or not)
+  std::uint64_t reads = 0;            ///< recv calls on sessions
+  std::uint64_t empty_reads = 0;      ///< of those, found nothing to read (EAGAIN)
+  std::uint64_t writes = 0;           ///< send calls on sessions
+  std::uint64_t gathered_writes = 0;  ///< of those, straight from a round's shared encoding
+  std::uint64_t partial_writes = 0;   ///< of those, taken only in part by the socket (slow reader)
 };
 
 /// Called once per RequestNode: the node's reply, or nullopt when no node of that name is

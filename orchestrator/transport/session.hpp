@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <array>
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/steady_timer.hpp>
 #include <cstdint>
@@ -69,7 +70,9 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   void TxConfirmed(std::span<const broker::TimedFrame> frames) override;
 
  private:
+  /// Reads what the socket holds, then waits for more (bus/wire/socket_io.hpp).
   void Read();
+  void WaitReadable();
   void Handle(const wire::Message& message);
   void OnHello(const wire::Hello& hello);
   void OnNodeReply(const wire::NodeReply& reply);
@@ -78,7 +81,14 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   void Refuse(const std::string& reason);
   void ProtocolError(const std::string& reason);
   void ScheduleFlush();
+  /// Writes filling_ now; what the socket does not take goes on through WriteRest.
   void Flush();
+  /// Writes a delivery straight from the round's shared encoding (with filling_ before it).
+  void WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs, std::size_t frames);
+  /// Writes writing_ asynchronously (one write in flight), then whatever collected meanwhile.
+  void WriteRest();
+  /// Everything queued has left: finish a lingering close, end a backlog episode.
+  void Written();
   void CloseSocket();
 
   broker::Broker& broker_;
@@ -101,8 +111,13 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   wire::Message message_;
   std::vector<CanFrame> submit_;  ///< frames of one received batch, reused
 
-  wire::MessageWriter filling_;
-  wire::MessageWriter writing_;
+  /// Runs per gathered write (the iovec array); a delivery cut into more (many per-receiver
+  /// exceptions of the fault stage) is copied into filling_ instead.
+  static constexpr std::size_t kMaxGatherRuns = 30;
+  std::array<std::uint8_t, wire::kMaxBatchHeader> header_{};  ///< of the gathered Frames message
+
+  wire::MessageWriter filling_;  ///< waiting for the next write
+  wire::MessageWriter writing_;  ///< the unwritten rest of a write the socket took only in part
   bool write_in_flight_ = false;
   bool flush_posted_ = false;
   std::uint64_t backlog_drops_ = 0;  ///< frames dropped in the current backlog episode
