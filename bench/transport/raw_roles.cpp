@@ -1,5 +1,8 @@
-// The raw baseline: a relay that forwards bare records between Unix sockets, and its nodes.
+// The raw baseline: a relay that forwards bare records between Unix (or TCP) sockets, and its nodes.
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/epoll.h>
 #include <sys/socket.h>
@@ -33,6 +36,11 @@ sockaddr_un UnixAddress(const std::string& path) {
   return addr;
 }
 
+void NoDelay(int fd) {
+  const int on = 1;
+  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
+}
+
 void SetNonBlocking(int fd) {
   ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
 }
@@ -48,16 +56,37 @@ bool WriteSome(int fd, std::vector<std::uint8_t>& out) {
 
 }  // namespace
 
-int RunRelay(const std::string& path, int ports) {
-  ::unlink(path.c_str());
-  const int listener = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  const sockaddr_un addr = UnixAddress(path);
-  if (::bind(listener, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 ||
-      ::listen(listener, 64) != 0) {
-    std::perror("relay: bind/listen");
-    return 1;
+int RunRelay(const std::string& where, int ports) {
+  // `where`: a Unix socket path, or "tcp" for a TCP listener on 127.0.0.1 (port chosen by the
+  // kernel, printed after "ready").
+  const bool tcp = where == "tcp";
+  int listener = -1;
+  std::string ready = "ready";
+  if (tcp) {
+    listener = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof addr;
+    if (::bind(listener, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 ||
+        ::listen(listener, 64) != 0 ||
+        ::getsockname(listener, reinterpret_cast<sockaddr*>(&addr), &length) != 0) {
+      std::perror("relay: bind/listen");
+      return 1;
+    }
+    ready += " tcp://127.0.0.1:" + std::to_string(ntohs(addr.sin_port));
+  } else {
+    ::unlink(where.c_str());
+    listener = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const sockaddr_un addr = UnixAddress(where);
+    if (::bind(listener, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 ||
+        ::listen(listener, 64) != 0) {
+      std::perror("relay: bind/listen");
+      return 1;
+    }
+    ready += " unix://" + where;
   }
-  std::printf("ready\n");
+  std::printf("%s\n", ready.c_str());
   std::fflush(stdout);
 
   struct Peer {
@@ -68,7 +97,9 @@ int RunRelay(const std::string& path, int ports) {
   std::vector<Peer> peers;
   while (static_cast<int>(peers.size()) < ports) {
     const int fd = ::accept4(listener, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (fd >= 0) peers.push_back({fd, {}, {}});
+    if (fd < 0) continue;
+    if (tcp) NoDelay(fd);  // as the broker: a batch is whole when written
+    peers.push_back({fd, {}, {}});
   }
   const int ep = ::epoll_create1(EPOLL_CLOEXEC);
   for (std::size_t i = 0; i < peers.size(); ++i) {
@@ -123,16 +154,28 @@ int RunRelay(const std::string& path, int ports) {
       }
     }
   }
-  ::unlink(path.c_str());
+  if (!tcp) ::unlink(where.c_str());
   return 0;
 }
 
 int RunRawClient(const ClientConfig& c) {
   const wire::Endpoint endpoint = wire::Endpoint::Parse(c.endpoint);
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  const sockaddr_un addr = UnixAddress(endpoint.path);
-  while (::connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  int fd = -1;
+  if (endpoint.kind == wire::Endpoint::Kind::kTcp) {
+    fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(endpoint.port);
+    ::inet_pton(AF_INET, endpoint.host.c_str(), &addr.sin_addr);
+    while (::connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    NoDelay(fd);
+  } else {
+    fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const sockaddr_un addr = UnixAddress(endpoint.path);
+    while (::connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   SetNonBlocking(fd);
   std::printf("ready\n");
   std::fflush(stdout);

@@ -32,7 +32,9 @@ int RunRawClient(const ClientConfig& config);
 /// The raw relay: accepts `ports` connections on `path` and forwards each one's whole records to
 /// all the others, one write per receiver per epoll round. The IPC limit of this machine for the
 /// broker's traffic shape, with none of the broker's work.
-int RunRelay(const std::string& path, int ports);
+/// `where`: a Unix socket path, or "tcp" (127.0.0.1, a port the kernel picks). Prints
+/// "ready ENDPOINT" once listening.
+int RunRelay(const std::string& where, int ports);
 
 /// "go T0 T1 T2".
 struct Window {

@@ -46,12 +46,14 @@ std::string BrokerProgram() {
 
 using namespace std::chrono_literals;
 
-enum class Path { kRaw, kUnix, kTcp };
+enum class Path { kRaw, kRawTcp, kUnix, kTcp };
 
 const char* Name(Path path) {
   switch (path) {
     case Path::kRaw:
       return "raw relay (unix)";
+    case Path::kRawTcp:
+      return "raw relay (tcp)";
     case Path::kUnix:
       return "broker, unix";
     case Path::kTcp:
@@ -66,7 +68,10 @@ bool Selected(Path path) {
   const char* list = std::getenv("CANFLEET_BENCH_PATHS");
   if (list == nullptr || *list == '\0') return true;
   const std::string paths = std::string(",") + list + ",";
-  const char* key = path == Path::kRaw ? ",raw," : path == Path::kUnix ? ",unix," : ",tcp,";
+  const char* key = path == Path::kRaw      ? ",raw,"
+                    : path == Path::kRawTcp ? ",rawtcp,"
+                    : path == Path::kUnix   ? ",unix,"
+                                            : ",tcp,";
   return paths.find(key) != std::string::npos;
 }
 
@@ -112,12 +117,13 @@ Result Run(Path path, int ports, bool latency, const Options& o) {
   TempDir dir;
   std::unique_ptr<BenchProcess> server;
   std::string endpoint;
-  if (path == Path::kRaw) {
-    const std::string socket = dir.File("relay.sock");
-    server = std::make_unique<BenchProcess>(
-        std::vector<std::string>{Self(), "relay", socket, std::to_string(ports)});
-    if (server->ReadLine(10s) != "ready") throw std::runtime_error("relay did not start");
-    endpoint = "unix://" + socket;
+  const bool raw = path == Path::kRaw || path == Path::kRawTcp;
+  if (raw) {
+    server = std::make_unique<BenchProcess>(std::vector<std::string>{
+        Self(), "relay", path == Path::kRawTcp ? "tcp" : dir.File("relay.sock"), std::to_string(ports)});
+    const auto ready = server->ReadLine(10s);
+    if (!ready || !ready->starts_with("ready ")) throw std::runtime_error("relay did not start");
+    endpoint = ready->substr(6);
   } else {
     const std::string ready = dir.File("ready");
     server = std::make_unique<BenchProcess>(std::vector<std::string>{
@@ -135,10 +141,9 @@ Result Run(Path path, int ports, bool latency, const Options& o) {
 
   std::vector<std::unique_ptr<BenchProcess>> clients;
   for (int i = 0; i < ports; ++i)
-    clients.push_back(std::make_unique<BenchProcess>(
-        std::vector<std::string>{Self(), "client", path == Path::kRaw ? "raw" : "broker", endpoint,
-                                 std::to_string(i), std::to_string(ports), std::to_string(o.window),
-                                 latency ? "latency" : "throughput", std::to_string(o.rate)}));
+    clients.push_back(std::make_unique<BenchProcess>(std::vector<std::string>{
+        Self(), "client", raw ? "raw" : "broker", endpoint, std::to_string(i), std::to_string(ports),
+        std::to_string(o.window), latency ? "latency" : "throughput", std::to_string(o.rate)}));
   for (auto& c : clients)
     if (c->ReadLine(20s) != "ready") throw std::runtime_error("a node did not connect");
 
@@ -219,23 +224,30 @@ int Driver(const Options& o) {
       "server CPU: broker (or relay) CPU time / wall time; ns/delivery: that CPU time per delivery;\n"
       "node ns/delivery: the CPU time of all node processes together per delivery\n\n");
   std::printf(
-      "| path              | ports | deliveries/s | frames/s  | vs raw | server CPU | ns/delivery |"
+      "| path              | ports | deliveries/s | frames/s  | vs raw | vs raw tcp | server CPU | "
+      "ns/delivery |"
       " node ns/delivery | p50 us | p99 us | loaded p50 us | loaded p99 us |\n");
   std::printf(
-      "|-------------------|------:|-------------:|----------:|-------:|-----------:|------------:|"
+      "|-------------------|------:|-------------:|----------:|-------:|-----------:|-----------:|-----------"
+      "-:|"
       "-----------------:|-------:|-------:|--------------:|--------------:|\n");
   for (int ports : o.ports) {
     double raw = 0;
-    for (Path path : {Path::kRaw, Path::kUnix, Path::kTcp}) {
+    double raw_tcp = 0;
+    for (Path path : {Path::kRaw, Path::kRawTcp, Path::kUnix, Path::kTcp}) {
       if (!Selected(path)) continue;
       const Result t = Run(path, ports, false, o);
       const Result l = Run(path, ports, true, o);
       if (path == Path::kRaw) raw = t.deliveries_per_s;
+      if (path == Path::kRawTcp) raw_tcp = t.deliveries_per_s;
+      // "vs raw": against the Unix-socket relay, the machine's IPC limit; for TCP also against
+      // the TCP relay, the same traffic on the same kernel path.
+      const double vs_tcp = path == Path::kTcp && raw_tcp > 0 ? 100 * t.deliveries_per_s / raw_tcp : 0;
       std::printf(
-          "| %-17s | %5d | %12.0f | %9.0f | %5.0f%% | %9.0f%% | %11.0f | %16.0f | %6.1f | %6.1f | %13.1f | "
-          "%13.1f |\n",
+          "| %-17s | %5d | %12.0f | %9.0f | %5.0f%% | %9.0f%% | %9.0f%% | %11.0f | %16.0f | %6.1f | %6.1f | "
+          "%13.1f | %13.1f |\n",
           Name(path), ports, t.deliveries_per_s, t.deliveries_per_s / (ports - 1),
-          raw > 0 ? 100 * t.deliveries_per_s / raw : 0, 100 * t.server_cpu,
+          raw > 0 ? 100 * t.deliveries_per_s / raw : 0, vs_tcp, 100 * t.server_cpu,
           t.deliveries_per_s > 0 ? 1e9 * t.server_cpu / t.deliveries_per_s : 0,
           t.deliveries_per_s > 0 ? 1e9 * t.nodes_cpu / t.deliveries_per_s : 0, l.latency.Percentile(0.5),
           l.latency.Percentile(0.99), t.latency.Percentile(0.5), t.latency.Percentile(0.99));
