@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
                  "How often BusStats are sampled and republished, seconds")
       ->check(CLI::Range(0.05, 3600.0))
       ->capture_default_str();
-  canfleet::telemetry::AddDdsOptions(app, dds);
+  canfleet::telemetry::AddDdsOptions(app, dds, canfleet::telemetry::DdsDiscovery::kMonitorsOnly);
   CLI11_PARSE(app, argc, argv);
 
   spdlog::set_default_logger(spdlog::stderr_color_mt("canfleet-broker"));

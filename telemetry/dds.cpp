@@ -1,5 +1,6 @@
 #include "telemetry/dds.hpp"
 
+#include <cstdlib>
 #include <map>
 #include <mutex>
 
@@ -24,37 +25,78 @@ void Entity::Reset() {
   handle_ = 0;
 }
 
+namespace {
+
+/// DdsDiscovery::kMonitorsOnly, appended to the user's configuration (later settings win; Peers
+/// are added to the configuration's own):
+/// - AllowMulticast false: join no multicast group, so other announcers' SPDP never reaches us;
+///   our own SPDP still goes to the peers, and 239.255.0.1 (Cyclone's default SPDP group, which
+///   monitors with a multicast configuration join) is one of them;
+/// - ParticipantIndex none: no fixed port (nobody probes for us; we are found by announcing);
+/// - MaxAutoParticipantIndex 19: the configuration's unicast peers (127.0.0.1 in the loopback
+///   configuration) are probed at participant indexes 0..19, where the monitors are;
+/// - SPDPInterval 1 s: a monitor started after us finds us within a second (Cyclone's default
+///   repeats the announcement only every 8 s or so).
+constexpr const char* kMonitorsOnlyConfig =
+    "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain Id=\"any\">"
+    "<General><AllowMulticast>false</AllowMulticast></General>"
+    "<Discovery><ParticipantIndex>none</ParticipantIndex>"
+    "<MaxAutoParticipantIndex>19</MaxAutoParticipantIndex>"
+    "<SPDPInterval>1s</SPDPInterval>"
+    "<Peers><Peer address=\"239.255.0.1\"/></Peers></Discovery>"
+    "</Domain></CycloneDDS>";
+
+}  // namespace
+
+std::string CycloneConfig(const DdsOptions& options) {
+  std::string config;
+  if (!options.config_file.empty()) {
+    config = "file://" + options.config_file;
+  } else if (options.discovery == DdsDiscovery::kMonitorsOnly) {
+    // An explicit domain ignores CYCLONEDDS_URI: carry it over.
+    const char* uri = std::getenv("CYCLONEDDS_URI");
+    if (uri != nullptr) config = uri;
+  }
+  if (options.discovery == DdsDiscovery::kMonitorsOnly) {
+    if (!config.empty()) config += ',';
+    config += kMonitorsOnlyConfig;
+  }
+  return config;
+}
+
 /// An explicitly created domain (dds_create_domain), shared by the participants of this process.
 /// Deleting a domain deletes every participant in it, so it must outlive all of them: the
 /// participants hold it by shared_ptr and the registry only by weak_ptr.
 class DomainRef {
  public:
-  DomainRef(std::uint32_t id, const std::string& config_file)
-      : config_file_(config_file),
-        entity_(CheckDds(dds_create_domain(id, ("file://" + config_file).c_str()),
-                         "create domain " + std::to_string(id) + " from " + config_file)) {}
-  const std::string& config_file() const { return config_file_; }
+  DomainRef(std::uint32_t id, const std::string& config, const std::string& description)
+      : config_(config),
+        entity_(CheckDds(dds_create_domain(id, config.c_str()),
+                         "create domain " + std::to_string(id) + " from " + description)) {}
+  const std::string& config() const { return config_; }
 
  private:
-  std::string config_file_;
+  std::string config_;
   Entity entity_;
 };
 
 namespace {
 
-std::shared_ptr<DomainRef> AcquireDomain(const DdsOptions& options) {
+std::shared_ptr<DomainRef> AcquireDomain(const DdsOptions& options, const std::string& config) {
   static std::mutex mutex;
   static std::map<std::uint32_t, std::weak_ptr<DomainRef>> domains;
   const std::lock_guard lock(mutex);
+  const std::string description =
+      options.config_file.empty() ? "the default configuration" : options.config_file;
   if (auto existing = domains[options.domain_id].lock()) {
-    if (existing->config_file() != options.config_file) {
-      throw DdsError("domain " + std::to_string(options.domain_id) + " already configured from " +
-                         existing->config_file() + ", not " + options.config_file,
+    if (existing->config() != config) {
+      throw DdsError("domain " + std::to_string(options.domain_id) +
+                         " already configured otherwise, not from " + description,
                      DDS_RETCODE_PRECONDITION_NOT_MET);
     }
     return existing;
   }
-  auto created = std::make_shared<DomainRef>(options.domain_id, options.config_file);
+  auto created = std::make_shared<DomainRef>(options.domain_id, config, description);
   domains[options.domain_id] = created;
   return created;
 }
@@ -62,7 +104,8 @@ std::shared_ptr<DomainRef> AcquireDomain(const DdsOptions& options) {
 }  // namespace
 
 Participant::Participant(const DdsOptions& options) {
-  if (!options.config_file.empty()) domain_ = AcquireDomain(options);
+  const std::string config = CycloneConfig(options);
+  if (!config.empty()) domain_ = AcquireDomain(options, config);
   entity_ = Entity(CheckDds(dds_create_participant(options.domain_id, nullptr, nullptr),
                             "create participant on domain " + std::to_string(options.domain_id)));
 }

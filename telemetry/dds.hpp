@@ -64,6 +64,22 @@ class Entity {
   dds_entity_t handle_ = 0;
 };
 
+/// Whom a participant discovers. Cyclone's default, every participant discovers every other one,
+/// costs each process state and discovery traffic per peer (about 30 kB of RSS per peer: a node of
+/// a 100-node fleet used 12.7 MB, issue 7), although a node only writes and nobody but the
+/// monitors reads it. So programs that only write announce themselves to the monitors instead.
+enum class DdsDiscovery : std::uint8_t {
+  /// Discover every participant of the domain (Cyclone's default): monitors (canfleet top and
+  /// watch, tests' readers) and anything that reads.
+  kAll,
+  /// Only announce: send our participant announcement (SPDP) every second to the monitors (the
+  /// default SPDP multicast group 239.255.0.1, and the configuration's peers at participant
+  /// indexes 0..19), listen to nobody's announcements, take no participant index. A monitor that
+  /// hears us answers, and we discover it; other announcers never meet. For programs that only
+  /// write: canfleet-node, canfleet-broker, canfleet up, canfleet-fake-fleet.
+  kMonitorsOnly,
+};
+
 /// The options every canfleet program takes: which DDS domain, and which Cyclone configuration.
 struct DdsOptions {
   std::uint32_t domain_id = 0;
@@ -71,12 +87,18 @@ struct DdsOptions {
   /// telemetry/cyclonedds-default.xml in containers). Empty: Cyclone's own lookup
   /// (the CYCLONEDDS_URI environment variable, else its built-in defaults).
   std::string config_file;
+  DdsDiscovery discovery = DdsDiscovery::kAll;
 };
+
+/// The Cyclone configuration `options` ask for, as dds_create_domain takes it: the file (or
+/// CYCLONEDDS_URI), followed by the announce-only settings for DdsDiscovery::kMonitorsOnly.
+/// Empty: Cyclone's defaults.
+std::string CycloneConfig(const DdsOptions& options);
 
 class DomainRef;
 
-/// A domain participant. With a config file, the domain is created explicitly from it
-/// (dds_create_domain) and shared by every Participant of this process on that domain id.
+/// A domain participant. With a configuration (CycloneConfig), the domain is created explicitly
+/// from it (dds_create_domain) and shared by every Participant of this process on that domain id.
 class Participant {
  public:
   explicit Participant(const DdsOptions& options = {});

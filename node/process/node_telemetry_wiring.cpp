@@ -21,7 +21,7 @@ void AddTelemetryOptions(CLI::App& app, TelemetrySettings& settings) {
       },
       "republish status and I/O at least this often, seconds (default 1)");
   period->check(CLI::Range(0.05, 3600.0));
-  telemetry::AddDdsOptions(app, settings.dds);
+  telemetry::AddDdsOptions(app, settings.dds, telemetry::DdsDiscovery::kMonitorsOnly);
 }
 
 namespace {

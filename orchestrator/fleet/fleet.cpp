@@ -34,6 +34,7 @@ LaunchSpec NodeLaunch(const FleetNode& node, const FleetOptions& options) {
   std::map<std::string, std::string> io(node.spec.io().begin(), node.spec.io().end());
   for (const auto& [name, value] : io)
     args.insert(args.end(), {"--io", name + "=" + value});
+  args.insert(args.end(), options.node_arguments.begin(), options.node_arguments.end());
   launch.log_file =
       std::filesystem::path(options.topology.orchestrator().state_root()) / "logs" / (node.name() + ".log");
   return launch;

@@ -35,6 +35,9 @@ struct FleetOptions {
   std::filesystem::path node_binary;
   std::string broker_endpoint;  ///< where started nodes connect ("tcp://127.0.0.1:29600")
   bool start_processes = true;  ///< false: `canfleet up --no-start`
+  /// Added to every node's command line: the DDS options `canfleet up` was given
+  /// (telemetry::DdsArguments), so its nodes publish where it does.
+  std::vector<std::string> node_arguments;
 };
 
 class Fleet final : public control::ControlHandler {

@@ -20,6 +20,7 @@
 #include "orchestrator/socketcand/server.hpp"
 #include "orchestrator/topology/topology_loader.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "telemetry/cli_options.hpp"
 #include "telemetry/orchestrator_telemetry.hpp"
 
 namespace canfleet::fleet {
@@ -115,6 +116,7 @@ int RunFleet(const UpOptions& options) {
     fleet_options.broker_endpoint = broker_endpoint;
     fleet_options.start_processes = !options.no_start;
     if (!options.no_start) fleet_options.node_binary = FindNodeBinary(options.node_binary);
+    fleet_options.node_arguments = telemetry::DdsArguments(options.dds);
     fleet = std::make_unique<Fleet>(io, scheduler, broker, server, std::move(fleet_options));
     control_server = std::make_unique<control::ControlServer>(io, *fleet);
     const auto bound = control_server->Listen(spec.orchestrator().control());
@@ -132,11 +134,10 @@ int RunFleet(const UpOptions& options) {
   std::optional<broker::BrokerTelemetry> bus_telemetry;
   if (options.telemetry) {
     try {
-      participant.emplace(
-          telemetry::DdsOptions{.domain_id = options.dds_domain, .config_file = options.dds_config});
+      participant.emplace(options.dds);
       publisher.emplace(*participant);
       bus_telemetry.emplace(broker, scheduler, *publisher);
-      spdlog::info("telemetry: BusStats and FaultEvents on DDS domain {}", options.dds_domain);
+      spdlog::info("telemetry: BusStats and FaultEvents on DDS domain {}", options.dds.domain_id);
     } catch (const std::exception& e) {
       spdlog::error("telemetry: {}; running without it", e.what());
       bus_telemetry.reset();

@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "telemetry/dds.hpp"
+
 namespace canfleet::fleet {
 
 struct UpOptions {
@@ -17,10 +19,10 @@ struct UpOptions {
   std::filesystem::path node_binary;          ///< canfleet-node; empty: beside this executable, then PATH
   std::filesystem::path ready_file;  ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
   std::string log_level = "info";
-  bool no_start = false;         ///< load and start the buses, but no node processes
-  bool telemetry = true;         ///< BusStats and FaultEvents on DDS
-  std::uint32_t dds_domain = 0;  ///< as canfleet-node's --dds-domain (env CANFLEET_DDS_DOMAIN)
-  std::string dds_config;        ///< as --dds-config (env CANFLEET_DDS_CONFIG)
+  bool no_start = false;  ///< load and start the buses, but no node processes
+  bool telemetry = true;  ///< BusStats and FaultEvents on DDS
+  /// Where the orchestrator publishes (canfleet up's --dds-* options); also passed to its nodes.
+  telemetry::DdsOptions dds;
 };
 
 /// Runs the fleet in the calling thread. Returns the process exit code: 0 after a clean

@@ -34,8 +34,7 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.log_level = args.log_level;
   options.no_start = args.no_start;
   options.telemetry = args.telemetry;
-  options.dds_domain = args.dds.domain_id;
-  options.dds_config = args.dds.config_file;
+  options.dds = args.dds;
   return fleet::RunFleet(options);
 }
 
@@ -77,7 +76,7 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   up->add_flag("--no-start", args->no_start, "Start the buses but no node processes");
   up->add_flag("!--no-telemetry", args->telemetry, "Do not publish BusStats and FaultEvents over DDS");
-  telemetry::AddDdsOptions(*up, args->dds);
+  telemetry::AddDdsOptions(*up, args->dds, telemetry::DdsDiscovery::kMonitorsOnly);
   up->callback([&cli, args] { cli.action = [&cli, args] { return RunUp(cli.global, *args); }; });
 
   CLI::App* down = app.add_subcommand("down", "Stop every node process and the orchestrator");

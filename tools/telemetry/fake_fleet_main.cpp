@@ -293,7 +293,7 @@ class FakeFleet {
 int main(int argc, char** argv) {
   CLI::App app{"Publish the telemetry of a synthetic CANopen fleet (tests, benchmarks, demos)"};
   DdsOptions dds;
-  AddDdsOptions(app, dds);
+  AddDdsOptions(app, dds, DdsDiscovery::kMonitorsOnly);
   std::string bus = "can0";
   std::string device = "fake-io";
   int nodes = 20;

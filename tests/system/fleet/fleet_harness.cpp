@@ -48,16 +48,27 @@ bool ParseJson(const std::string& json, google::protobuf::Message& message, std:
   return status.ok();
 }
 
-FleetUnderTest::FleetUnderTest(const std::string& topology, const std::string& listen) {
+FleetUnderTest::FleetUnderTest(const std::string& topology, const std::string& listen,
+                               const std::vector<std::string>& up_args) {
   // The fleet's nodes publish telemetry; keep it off other tests' DDS domain.
   ::setenv("CANFLEET_DDS_DOMAIN", "76", 0);
   const std::string file = dir_.File("fleet.textproto");
   std::ofstream(file) << topology;
-  up_ = std::make_unique<ChildProcess>(
-      std::vector<std::string>{PROGRAM_CANFLEET, "up", file, "--control", "tcp://127.0.0.1:0", "--listen",
-                               listen, "--ready-file", dir_.File("ready"), "--node-binary",
-                               PROGRAM_CANFLEET_NODE, "--log-level", "debug"},
-      dir_.File("orchestrator.log"));
+  std::vector<std::string> argv = {PROGRAM_CANFLEET,
+                                   "up",
+                                   file,
+                                   "--control",
+                                   "tcp://127.0.0.1:0",
+                                   "--listen",
+                                   listen,
+                                   "--ready-file",
+                                   dir_.File("ready"),
+                                   "--node-binary",
+                                   PROGRAM_CANFLEET_NODE,
+                                   "--log-level",
+                                   "debug"};
+  argv.insert(argv.end(), up_args.begin(), up_args.end());
+  up_ = std::make_unique<ChildProcess>(argv, dir_.File("orchestrator.log"));
   WaitUntil(
       [&] {
         const std::string ready = ReadFile(dir_.File("ready"));

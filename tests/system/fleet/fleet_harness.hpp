@@ -27,8 +27,10 @@ CliResult RunCanfleet(const std::vector<std::string>& args);
 class FleetUnderTest {
  public:
   /// Writes `topology` (text format) as DIR/fleet.textproto and starts `canfleet up` on it, its
-  /// broker listening on `listen` (default: a port the kernel picks).
-  explicit FleetUnderTest(const std::string& topology, const std::string& listen = "tcp://127.0.0.1:0");
+  /// broker listening on `listen` (default: a port the kernel picks), with `up_args` added to its
+  /// command line.
+  explicit FleetUnderTest(const std::string& topology, const std::string& listen = "tcp://127.0.0.1:0",
+                          const std::vector<std::string>& up_args = {});
   /// SIGTERM to the orchestrator; waits for it; checks no node process is left.
   ~FleetUnderTest();
 

@@ -136,5 +136,26 @@ TEST(FleetTelemetryRealNodes, EveryNodeTheEmcyTheFaultEventTheRecoveryAndLateJoi
                               kFleetPatience));
 }
 
+TEST(FleetTelemetryOptions, CanfleetUpPassesItsDdsOptionsToItsNodes) {
+  // `canfleet up --dds-domain D --dds-config F` publishes there, and so do the nodes it starts
+  // (they used to see only the environment, so a domain given on the command line left the nodes
+  // on another). Nothing in the environment says where.
+  ::unsetenv("CANFLEET_DDS_CONFIG");
+  ::setenv("CANFLEET_DDS_DOMAIN", "76", 1);  // a decoy: the command line must win
+  constexpr std::uint32_t kOptionDomain = 79;
+  Monitor monitor(kOptionDomain, CANFLEET_DDS_LOOPBACK_CONFIG);
+  FleetUnderTest fleet(
+      "name: \"dds-options\"\n"
+      "bus { name: \"can0\" bitrate: 500000 }\n"
+      "node { name: \"quad-3\" device: \"quad-controller\" node_id: 3 bus: \"can0\" }\n",
+      "tcp://127.0.0.1:0",
+      {"--dds-domain", std::to_string(kOptionDomain), "--dds-config", CANFLEET_DDS_LOOPBACK_CONFIG});
+  ASSERT_TRUE(fleet.WaitReady()) << fleet.Log();
+  EXPECT_TRUE(monitor.Until([&] { return IsOperational(monitor.Node("can0", 3)); }, kFleetPatience))
+      << "quad-3 not seen on DDS domain " << kOptionDomain;
+  // The orchestrator's own BusStats are there too.
+  EXPECT_TRUE(monitor.Until([&] { return monitor.view().buses().count("can0") == 1; }));
+}
+
 }  // namespace
 }  // namespace canfleet::system_test

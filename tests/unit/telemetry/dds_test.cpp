@@ -1,6 +1,8 @@
 // The RAII wrappers over the Cyclone C API, with real DDS inside this process.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "telemetry/dds.hpp"
 #include "telemetry/samples.hpp"
 #include "telemetry/topics.hpp"
@@ -17,6 +19,43 @@ TEST(DdsError, NamesTheOperationAndTheReturnCode) {
   EXPECT_EQ(error.code(), DDS_RETCODE_BAD_PARAMETER);
   EXPECT_NE(std::string(error.what()).find("create writer x: "), std::string::npos);
   EXPECT_NE(std::string(error.what()).find(dds_strretcode(-DDS_RETCODE_BAD_PARAMETER)), std::string::npos);
+}
+
+// DdsDiscovery::kMonitorsOnly (dds.hpp): the announce-only settings follow the configuration, so
+// they win over it, and an explicit domain must carry CYCLONEDDS_URI, which it would ignore.
+TEST(CycloneConfig, MonitorsSeeEverythingWithTheirConfigurationAsItIs) {
+  EXPECT_EQ(CycloneConfig({.domain_id = 1, .config_file = "/etc/x.xml", .discovery = DdsDiscovery::kAll}),
+            "file:///etc/x.xml");
+  EXPECT_EQ(CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kAll}),
+            "");  // Cyclone's own lookup (CYCLONEDDS_URI, defaults)
+}
+
+TEST(CycloneConfig, WritersAppendTheAnnounceOnlySettings) {
+  const std::string config =
+      CycloneConfig({.domain_id = 1, .config_file = "/etc/x.xml", .discovery = DdsDiscovery::kMonitorsOnly});
+  ASSERT_TRUE(config.starts_with("file:///etc/x.xml,<CycloneDDS")) << config;
+  EXPECT_NE(config.find("<AllowMulticast>false</AllowMulticast>"), std::string::npos);
+  EXPECT_NE(config.find("<ParticipantIndex>none</ParticipantIndex>"), std::string::npos);
+  EXPECT_NE(config.find("<SPDPInterval>1s</SPDPInterval>"), std::string::npos);
+  EXPECT_NE(config.find("<Peer address=\"239.255.0.1\"/>"), std::string::npos);
+}
+
+TEST(CycloneConfig, WritersWithoutAFileKeepCycloneddsUri) {
+  ::setenv("CYCLONEDDS_URI", "file:///from/env.xml", 1);
+  const std::string config =
+      CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly});
+  ::unsetenv("CYCLONEDDS_URI");
+  EXPECT_TRUE(config.starts_with("file:///from/env.xml,<CycloneDDS")) << config;
+  EXPECT_TRUE(CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly})
+                  .starts_with("<CycloneDDS"));
+}
+
+TEST(CycloneConfig, AWriterStartsWithTheAnnounceOnlySettings) {
+  // Cyclone accepts the composed configuration (a malformed fragment would throw here).
+  DdsOptions options = TestDds(27);
+  options.discovery = DdsDiscovery::kMonitorsOnly;
+  Participant writer(options);
+  EXPECT_GT(writer.handle(), 0);
 }
 
 TEST(Participant, AMissingConfigFileThrowsAtStartup) {
