@@ -6,7 +6,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <sys/wait.h>
@@ -79,26 +79,46 @@ ChildProcess::ChildProcess(std::vector<std::string> argv, std::string stderr_pat
     : stderr_path_(std::move(stderr_path)) {
   int in[2];
   int out[2];
-  if (::pipe2(in, O_CLOEXEC) != 0 || ::pipe2(out, O_CLOEXEC) != 0) Fail("pipe2");
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, in[0], STDIN_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, stderr_path_.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  int exec_error[2];  // the child writes errno here if exec fails; closed by a successful exec
+  if (::pipe2(in, O_CLOEXEC) != 0 || ::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(exec_error, O_CLOEXEC) != 0)
+    Fail("pipe2");
+  const int err = ::open(stderr_path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (err < 0) Fail("open " + stderr_path_);
   std::vector<char*> args;
   for (auto& a : argv)
     args.push_back(a.data());
   args.push_back(nullptr);
-  const int rc = ::posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const pid_t parent = ::getpid();
+  // fork + exec rather than posix_spawn, for PR_SET_PDEATHSIG: a test that crashes or is killed
+  // (ctest's timeout) takes its children with it instead of leaving nodes and brokers running.
+  // Between fork and exec only async-signal-safe calls (the test may run other threads).
+  pid_ = ::fork();
+  if (pid_ < 0) Fail("fork");
+  if (pid_ == 0) {
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);  // the test died before prctl took effect
+    ::dup2(in[0], STDIN_FILENO);
+    ::dup2(out[1], STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    ::execve(args[0], args.data(), environ);
+    const int error = errno;
+    [[maybe_unused]] const auto ignored = ::write(exec_error[1], &error, sizeof error);
+    ::_exit(127);
+  }
   ::close(in[0]);
   ::close(out[1]);
+  ::close(err);
+  ::close(exec_error[1]);
   stdin_fd_ = in[1];
   stdout_fd_ = out[0];
-  if (rc != 0) {
-    errno = rc;
-    Fail("posix_spawn " + argv[0]);
+  int error = 0;
+  const ssize_t got = ::read(exec_error[0], &error, sizeof error);  // 0: exec succeeded
+  ::close(exec_error[0]);
+  if (got == sizeof error) {
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+    errno = error;
+    Fail("exec " + argv[0]);
   }
   ::fcntl(stdout_fd_, F_SETFL, ::fcntl(stdout_fd_, F_GETFL) | O_NONBLOCK);
   // A child that exits must not kill us with SIGPIPE when we write to its stdin.
