@@ -37,11 +37,12 @@ namespace {
 ///   configuration) are probed at participant indexes 0..19, where the monitors are;
 /// - SPDPInterval 1 s: a monitor started after us finds us within a second (Cyclone's default
 ///   repeats the announcement only every 8 s or so);
-/// - Sizing: receive buffers of 64 KiB in chunks of 16 KiB (Cyclone: 1 MiB and 128 KiB). A writer
-///   receives only discovery and acknowledgements, in packets below Cyclone's MaxMessageSize
-///   (14720 B; a larger one would be dropped and sent again in smaller pieces). Packets are laid
-///   one after the other in a receive buffer, so a node that ran for hours touched every page of
-///   its 1 MiB buffers: RSS grew by about 8 kB a minute towards +1 MiB per receive thread.
+/// - Sizing: receive buffers of 32 KiB in chunks of 16 KiB (Cyclone: 1 MiB and 128 KiB), and one
+///   receive thread. A writer receives only discovery and acknowledgements, in packets below
+///   Cyclone's MaxMessageSize (14720 B; a larger one would be dropped and sent again in smaller
+///   pieces). Packets are laid one after another in a receive buffer, so with 1 MiB buffers a node
+///   touched a page more every half minute for hours (RSS +8 kB a minute for as long as it ran,
+///   measured, towards +1 MiB per receive thread); 32 KiB buffers bound that to a few pages.
 constexpr const char* kMonitorsOnlyConfig =
     "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain Id=\"any\">"
     "<General><AllowMulticast>false</AllowMulticast></General>"
@@ -49,7 +50,8 @@ constexpr const char* kMonitorsOnlyConfig =
     "<MaxAutoParticipantIndex>19</MaxAutoParticipantIndex>"
     "<SPDPInterval>1s</SPDPInterval>"
     "<Peers><Peer address=\"239.255.0.1\"/></Peers></Discovery>"
-    "<Sizing><ReceiveBufferSize>64KiB</ReceiveBufferSize>"
+    "<Internal><MultipleReceiveThreads>false</MultipleReceiveThreads></Internal>"
+    "<Sizing><ReceiveBufferSize>32KiB</ReceiveBufferSize>"
     "<ReceiveBufferChunkSize>16KiB</ReceiveBufferChunkSize></Sizing>"
     "</Domain></CycloneDDS>";
 

@@ -71,38 +71,33 @@ int RunBrokerClient(const ClientConfig& c) {
     StoreTime(MonotonicNs(), f.data.data());
     return port.Send(f);
   };
-  // The window, kept without a division per frame: every `others` frames received allow one more.
-  std::uint64_t allowed = c.window;
-  std::uint64_t toward_next = 0;
   auto pump = [&] {
-    while (sent < allowed + extra) {
+    const std::uint64_t allowed = port.Stats().rx_frames / others + c.window + extra;
+    while (sent < allowed) {
       if (!send_one()) break;
       ++sent;
     }
   };
-  // The clock is read once per socket read (the frames of one batch), as the raw node reads it
-  // once per recv: per-frame clock reads would cost more than the transport itself. The port
-  // writes what the node sent while a batch was delivered in one write when the batch is done, as
-  // the raw node sends once per recv.
+  // Per frame this node does what the raw node does per record (count it, and record its latency
+  // inside the measurement window); the rest is done once per socket read, as the raw node does
+  // it once per recv: read the clock, decide whether the read is inside the window, and send what
+  // the window allows (the port writes it in one write when the read's frames are delivered).
   const BrokerClientStats& port_stats = port.Stats();  // stays valid while the port lives
   std::uint64_t seen_reads = 0;
   std::int64_t turn_now = 0;
+  bool turn_in_window = false;
   port.OnReceive([&](const CanFrame& f, BusTime) {
     if (port_stats.reads != seen_reads) {
       seen_reads = port_stats.reads;
       turn_now = MonotonicNs();
+      turn_in_window = turn_now >= window.start && turn_now < window.end;
+      if (going && !c.latency && turn_now < window.stop) pump();
     }
-    const std::int64_t now = turn_now;
     ++received;
-    if (now >= window.start && now < window.end) {
+    if (turn_in_window) {
       ++in_window;
-      histogram.Add(now - LoadTime(f.data.data()));
+      histogram.Add(turn_now - LoadTime(f.data.data()));
     }
-    if (++toward_next == others) {
-      toward_next = 0;
-      ++allowed;
-    }
-    if (going && !c.latency && now < window.stop) pump();
   });
 
   asio::posix::stream_descriptor input(io, ::dup(STDIN_FILENO));
