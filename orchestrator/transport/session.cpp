@@ -367,28 +367,8 @@ void Session::WriteGathered(const std::uint8_t* records, std::span<const broker:
   for (const broker::FrameRun& run : runs)
     buffers[count++] = {const_cast<std::uint8_t*>(records + std::size_t{run.begin} * wire::kFrameRecordSize),
                         std::size_t{run.size()} * wire::kFrameRecordSize};
-  const std::span<const iovec> message(buffers.data(), count);
-  std::error_code ec;
-  const std::size_t sent = wire::SendNow(socket_.native_handle(), message, ec);
-  stats_->writes++;
   stats_->gathered_writes++;
-  if (ec && !wire::WouldBlock(ec)) {
-    Close(ec.message(), Farewell::kNone, spdlog::level::info);
-    return;
-  }
-  const std::size_t total = wire::TotalSize(message);
-  if (sent == total) {
-    filling_.Clear();
-    return;
-  }
-  // The socket took only part: the rest is this session's to keep until it can be written.
-  stats_->partial_writes++;
-  writing_.Clear();
-  wire::AppendUnsent(message, sent, [this](const std::uint8_t* bytes, std::size_t size) {
-    writing_.AddEncoded(bytes, size);
-  });
-  filling_.Clear();
-  WriteRest();
+  SendNow({buffers.data(), count});  // may close the session: nothing after it
 }
 
 void Session::ControllerChanged(const ControllerEvent& event) {
@@ -415,8 +395,12 @@ void Session::Flush() {
   if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
   const std::span<const std::uint8_t> bytes = filling_.Bytes();
   const iovec buffer{const_cast<std::uint8_t*>(bytes.data()), bytes.size()};
+  SendNow({&buffer, 1});
+}
+
+void Session::SendNow(std::span<const iovec> message) {
   std::error_code ec;
-  const std::size_t sent = wire::SendNow(socket_.native_handle(), {&buffer, 1}, ec);
+  const std::size_t sent = wire::SendNow(socket_.native_handle(), message, ec);
   stats_->writes++;
   if (ec && !wire::WouldBlock(ec)) {
     if (closed_)
@@ -425,14 +409,17 @@ void Session::Flush() {
       Close(ec.message(), Farewell::kNone, spdlog::level::info);
     return;
   }
-  if (sent == bytes.size()) {
+  if (sent == wire::TotalSize(message)) {
     filling_.Clear();
     Written();
     return;
   }
+  // The socket took only part: the rest is this session's to keep until it can be written.
   stats_->partial_writes++;
   writing_.Clear();
-  writing_.AddEncoded(bytes.data() + sent, bytes.size() - sent);
+  wire::AppendUnsent(message, sent, [this](const std::uint8_t* bytes, std::size_t size) {
+    writing_.AddEncoded(bytes, size);
+  });
   filling_.Clear();
   WriteRest();
 }

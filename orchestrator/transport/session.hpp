@@ -4,7 +4,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <sys/uio.h>
 #include <array>
+
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/steady_timer.hpp>
 #include <cstdint>
@@ -83,6 +85,9 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   void ScheduleFlush();
   /// Writes filling_ now; what the socket does not take goes on through WriteRest.
   void Flush();
+  /// One sendmsg of `message`, which starts with filling_'s bytes (if any): on success filling_
+  /// is empty; what the socket did not take is copied into writing_ for WriteRest.
+  void SendNow(std::span<const iovec> message);
   /// Writes a delivery straight from the round's shared encoding (with filling_ before it).
   void WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs, std::size_t frames);
   /// Writes writing_ asynchronously (one write in flight), then whatever collected meanwhile.
