@@ -71,6 +71,17 @@ class Transport : public ::testing::Test {
     return std::make_unique<BrokerClientPort>(io_, options);
   }
 
+  /// Two clients, "a" and "b", attached to a new unpaced bus "fast" of `server`.
+  std::pair<std::unique_ptr<BrokerClientPort>, std::unique_ptr<BrokerClientPort>> ConnectedPair(
+      transport::BrokerServer& server) {
+    broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false});
+    const std::string ep = Listen(server);
+    auto a = Client(ep, "a", "fast");
+    auto b = Client(ep, "b", "fast");
+    EXPECT_TRUE(RunUntil([&] { return a->Connected() && b->Connected(); }));
+    return {std::move(a), std::move(b)};
+  }
+
   TempDir dir_;
   asio::io_context io_;
   AsioScheduler scheduler_{io_};
@@ -81,13 +92,10 @@ TEST_F(Transport, ManySendsInOneTurnLeaveInOneWrite) {
   // "Send() appends to an outgoing batch flushed once per io_context turn": 1000 frames sent from
   // one handler are one socket write.
   transport::BrokerServer server(io_, broker_);
-  broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false});
-  const std::string ep = Listen(server);
-  auto a = Client(ep, "a", "fast");
-  auto b = Client(ep, "b", "fast");
+  auto [a, b] = ConnectedPair(server);
+  ASSERT_TRUE(a->Connected() && b->Connected());
   std::vector<std::pair<CanFrame, BusTime>> got;
   b->OnReceive([&](const CanFrame& f, BusTime t) { got.emplace_back(f, t); });
-  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b->Connected(); }));
   ASSERT_TRUE(RunUntil([&] { return a->Stats().writes >= 1; }));  // the Hello has left
   const auto writes_before = a->Stats().writes;
   asio::post(io_, [&] {
@@ -110,13 +118,10 @@ TEST_F(Transport, SocketsAreReadOnlyWhenDataWaits) {
   // then half of all reads returned EAGAIN. 300 batches, one per io_context turn, each waiting for
   // its delivery, must cost (nearly) no empty reads on either side.
   transport::BrokerServer server(io_, broker_);
-  broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false});
-  const std::string ep = Listen(server);
-  auto a = Client(ep, "a", "fast");
-  auto b = Client(ep, "b", "fast");
+  auto [a, b] = ConnectedPair(server);
+  ASSERT_TRUE(a->Connected() && b->Connected());
   std::size_t got = 0;
   b->OnReceive([&](const CanFrame&, BusTime) { ++got; });
-  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b->Connected(); }));
   const auto server_before = server.Stats();
   const auto b_before = b->Stats();
   constexpr std::size_t kBatches = 300;
