@@ -16,12 +16,14 @@
 #include <cstddef>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
 #include "clock/scheduler.hpp"
 #include "node/canopen/stack/canopen_stack.hpp"
 #include "node/canopen/stack/error_policy.hpp"
+#include "node/devices/device_port.hpp"
 #include "node/devices/simulated_io.hpp"
 
 namespace canfleet::devices {
@@ -30,6 +32,8 @@ namespace canfleet::devices {
 struct DeviceOptions {
   /// Replaces the variant's own EDS (a user-edited copy); empty = the EDS shipped with the variant.
   std::filesystem::path eds;
+  /// CAN ports of the product, from its catalog entry (registry.hpp), the one place that says it.
+  std::size_t ports = 1;
 };
 
 /// How the stack of one port will be built. DeviceNode fills the node-level options (node-ID,
@@ -41,10 +45,12 @@ struct StackSetup {
   std::shared_ptr<const canopen::ErrorPolicy> policy;
 };
 
-/// What a device attaches to: the clock and one stack per port (stack i runs on port i).
+/// What a device attaches to: the clock, one stack per port (stack i runs on port i) and the
+/// ports themselves, through which a device may observe frames, mute or send (device_port.hpp).
 struct DeviceContext {
   Scheduler& scheduler;
   std::vector<canopen::CanopenStack*> stacks;
+  std::vector<DevicePort*> ports;
 };
 
 class Device {
@@ -54,8 +60,18 @@ class Device {
   /// The --device name ("quad-controller"); "generic" for an EDS-only node.
   virtual std::string_view Name() const = 0;
   /// CAN ports of the product: 1, or 2 for the data logger (one stack per port, shared
-  /// application objects: see shared_objects.hpp).
-  virtual std::size_t PortCount() const { return 1; }
+  /// application objects: see SharedObjects()). Set from the catalog entry at construction.
+  std::size_t PortCount() const { return ports_; }
+
+  /// A range of objects of a multi-port device that are one set for the whole device (the data
+  /// logger's application objects, 2000h-FFFFh): port 1's dictionary owns them and every other
+  /// port's dictionary borrows them (ObjectDictionary::Borrow). A store (1010h) or restore (1011h)
+  /// on any port covers them once, through port 1's parameter store. nullopt: nothing shared.
+  struct ObjectRange {
+    std::uint16_t first;
+    std::uint16_t last;
+  };
+  virtual std::optional<ObjectRange> SharedObjects() const { return std::nullopt; }
 
   /// Fills the dictionary of port `port` with every object of the device (communication and
   /// application area). Runs before any stack exists; install no hooks here.
@@ -80,7 +96,12 @@ class Device {
   const SimulatedIo& io() const { return io_; }
 
  protected:
+  explicit Device(std::size_t ports = 1) : ports_(ports) {}
+
   SimulatedIo io_;
+
+ private:
+  std::size_t ports_;
 };
 
 }  // namespace canfleet::devices

@@ -1,6 +1,8 @@
 #include "node/devices/device_node.hpp"
 
 #include <stdexcept>
+
+#include "node/canopen/storage/parameter_store.hpp"
 #include <string>
 
 namespace canfleet::devices {
@@ -51,11 +53,13 @@ DeviceNode::DeviceNode(std::unique_ptr<Device> device, Scheduler& scheduler, std
   }
   for (std::size_t p = 0; p < count; ++p) {
     if (!ports[p]) throw std::invalid_argument("DeviceNode: port " + std::to_string(p + 1) + " is null");
+    device_ports_.push_back(std::make_unique<DevicePort>(*ports[p]));
     auto od = std::make_unique<canopen::ObjectDictionary>();
     device_->Build(p, *od);
     if (settings.serial_number) ApplySerialNumber(*od, *settings.serial_number);
     dictionaries_.push_back(std::move(od));
   }
+  ShareObjects();
   for (std::size_t p = 0; p < count; ++p) {
     StackSetup setup;
     PortSettings port = p < settings.ports.size() ? settings.ports[p] : PortSettings{};
@@ -67,13 +71,77 @@ DeviceNode::DeviceNode(std::unique_ptr<Device> device, Scheduler& scheduler, std
     device_->ConfigureStack(p, setup);
     setup.hooks = ChainHooks(std::move(setup.hooks), settings.hooks);
     stacks_.push_back(std::make_unique<canopen::CanopenStack>(
-        *dictionaries_[p], *ports[p], scheduler, std::move(setup.options), std::move(setup.hooks),
+        *dictionaries_[p], *device_ports_[p], scheduler, std::move(setup.options), std::move(setup.hooks),
         std::move(setup.policy)));
   }
-  DeviceContext context{scheduler, {}};
-  for (auto& stack : stacks_)
-    context.stacks.push_back(stack.get());
+  ForwardSharedStorage();
+  DeviceContext context{scheduler, {}, {}};
+  for (std::size_t p = 0; p < count; ++p) {
+    context.stacks.push_back(stacks_[p].get());
+    context.ports.push_back(device_ports_[p].get());
+  }
   device_->Attach(context);
+}
+
+namespace {
+
+/// The 1010h/1011h sub-index of a parameter group (CiA 301 §7.5.2.13: 2 comm, 3 application,
+/// 4 manufacturer).
+std::uint8_t SubIndexOf(canopen::StoreGroup group) {
+  switch (group) {
+    case canopen::StoreGroup::kCommunication:
+      return 2;
+    case canopen::StoreGroup::kApplication:
+      return 3;
+    default:
+      return 4;
+  }
+}
+
+}  // namespace
+
+void DeviceNode::ShareObjects() {
+  const auto range = device_->SharedObjects();
+  if (!range || dictionaries_.size() < 2) return;
+  auto& owned = dictionaries_[0]->objects();
+  for (auto it = owned.lower_bound(range->first); it != owned.end() && it->first <= range->last; ++it) {
+    for (std::size_t p = 1; p < dictionaries_.size(); ++p)
+      dictionaries_[p]->Borrow(it->second);
+  }
+}
+
+// A 1010h/1011h command on another port also stores (restores) the shared objects, once, in port
+// 1's parameter store: its groups that overlap the shared range (manufacturer 2000h-5FFFh, sub 4;
+// application 6000h-9FFFh, sub 3). "All" (sub 1) covers both; "communication" (sub 2) neither.
+void DeviceNode::ForwardSharedStorage() {
+  const auto range = device_->SharedObjects();
+  canopen::ParameterStore* primary = stacks_.empty() ? nullptr : stacks_[0]->store();
+  if (!range || !primary) return;
+  for (std::size_t p = 1; p < stacks_.size(); ++p) {
+    for (const std::uint16_t index : {std::uint16_t{0x1010}, std::uint16_t{0x1011}}) {
+      canopen::Object* object = dictionaries_[p]->Find(index);
+      if (!object) continue;
+      const bool store = index == 0x1010;
+      const std::uint32_t signature = store ? canopen::kSaveSignature : canopen::kLoadSignature;
+      for (auto& [sub_index, sub] : object->subs) {
+        if (sub_index == 0 || sub_index == 2) continue;
+        sub.validators.push_back([primary, store, signature, range = *range](
+                                     const canopen::SubObject& s, std::span<const std::uint8_t> data,
+                                     canopen::Origin) {
+          if (data.size() != 4 || canopen::DecodeUnsignedLe(data) != signature) return canopen::SdoAbort::kNone;
+          for (const auto& group : canopen::ParameterGroups()) {
+            const std::uint8_t group_sub = SubIndexOf(group.group);
+            const bool in_command = s.sub_index == 1 || s.sub_index == group_sub ||
+                                    (s.sub_index > 4 && group.group == canopen::StoreGroup::kManufacturer);
+            if (!in_command || group.last < range.first || group.first > range.last) continue;
+            const auto rc = store ? primary->Save(group_sub) : primary->MarkRestoreDefaults(group_sub);
+            if (rc != canopen::SdoAbort::kNone) return rc;
+          }
+          return canopen::SdoAbort::kNone;
+        });
+      }
+    }
+  }
 }
 
 DeviceNode::~DeviceNode() {

@@ -18,6 +18,7 @@
 #include "clock/scheduler.hpp"
 #include "node/canopen/stack/canopen_stack.hpp"
 #include "node/devices/device.hpp"
+#include "node/devices/device_port.hpp"
 
 namespace canfleet::devices {
 
@@ -63,8 +64,12 @@ class DeviceNode {
   canopen::ObjectDictionary& od(std::size_t port = 0) { return *dictionaries_.at(port); }
 
  private:
+  void ShareObjects();
+  void ForwardSharedStorage();
+
   // Destroyed in reverse order: the device (its timers and blocks) before the stacks, the stacks
   // before the dictionaries they hook into.
+  std::vector<std::unique_ptr<DevicePort>> device_ports_;
   std::vector<std::unique_ptr<canopen::ObjectDictionary>> dictionaries_;
   std::vector<std::unique_ptr<canopen::CanopenStack>> stacks_;
   std::unique_ptr<Device> device_;

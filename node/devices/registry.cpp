@@ -1,19 +1,39 @@
 #include "node/devices/registry.hpp"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <vector>
 
+#include "node/devices/eds_dictionary.hpp"
 #include "node/devices/generic_device.hpp"
 #include "node/devices/quad_controller/quad_controller.hpp"
 
 namespace canfleet::devices {
+namespace {
+
+template <typename T>
+std::unique_ptr<Device> Create(const DeviceOptions& options) {
+  return std::make_unique<T>(options);
+}
+
+}  // namespace
 
 std::span<const DeviceInfo> Devices() {
-  static const std::vector<DeviceInfo> devices = {
-      {QuadController::kName, QuadController::kSummary, 1,
-       [](const DeviceOptions& options) { return std::make_unique<QuadController>(options); }},
-  };
+  static const std::array<DeviceInfo, 1> devices = {{
+      {.name = QuadController::kName,
+       .summary = QuadController::kSummary,
+       .ports = 1,
+       // AX020506 states no factory node-ID or bit rate (§2.1: "set by LSS"); the family's four
+       // other manuals all ship at 127 and 125 kbit/s (valve §3.1, power supply §2.1, encoder
+       // C3-1.1, data logger §3.1), so the Quad does too (quad_controller/README.md).
+       .factory_node_id = 127,
+       .factory_bit_rate_kbit = 125,
+       .eds_file_name = "quad-controller.eds",
+       .eds_text = QuadControllerEdsText,
+       .declare_signals = [](SimulatedIo& io) { quad::QuadIo declared(io); },
+       .create = Create<QuadController>},
+  }};
   return devices;
 }
 
@@ -33,9 +53,38 @@ std::string ListDevices() {
     out += std::string(info.name);
     out += std::string(width - info.name.size() + 2, ' ');
     out += std::to_string(info.ports) + (info.ports == 1 ? " port   " : " ports  ");
+    std::string factory = "id " + std::to_string(info.factory_node_id) + " @ " +
+                          std::to_string(info.factory_bit_rate_kbit) + " kbit/s";
+    out += factory + std::string(factory.size() < 22 ? 22 - factory.size() : 1, ' ');
     out += std::string(info.summary) + "\n";
   }
   return out;
+}
+
+std::string KnownDeviceNames() {
+  std::string known;
+  for (const DeviceInfo& d : Devices())
+    known += (known.empty() ? "" : ", ") + std::string(d.name);
+  return known;
+}
+
+std::unique_ptr<SimulatedIo> SignalsOf(const DeviceInfo& info) {
+  auto io = std::make_unique<SimulatedIo>();
+  info.declare_signals(*io);
+  return io;
+}
+
+canopen::ObjectDictionary VariantDictionary(const DeviceInfo& info, const std::filesystem::path& eds) {
+  return LoadVariantDictionary(info.eds_text(), info.eds_file_name, eds);
+}
+
+std::optional<std::uint8_t> BitTimingIndexOf(std::uint32_t kbit) {
+  // CiA 305 §5.5 table 0 (the LSS bit timing table); index 5 is reserved (100 kbit/s in CiA 301).
+  static constexpr std::array<std::uint32_t, 9> kTable = {1000, 800, 500, 250, 125, 100, 50, 20, 10};
+  for (std::size_t i = 0; i < kTable.size(); ++i) {
+    if (kTable[i] == kbit && i != 5) return static_cast<std::uint8_t>(i);
+  }
+  return std::nullopt;
 }
 
 std::unique_ptr<Device> MakeDevice(const DeviceSelection& selection) {
@@ -45,12 +94,9 @@ std::unique_ptr<Device> MakeDevice(const DeviceSelection& selection) {
   }
   const DeviceInfo* info = FindDevice(selection.device);
   if (!info) {
-    std::string known;
-    for (const DeviceInfo& d : Devices())
-      known += (known.empty() ? "" : ", ") + std::string(d.name);
-    throw std::invalid_argument("unknown device \"" + selection.device + "\" (known: " + known + ")");
+    throw std::invalid_argument("unknown device \"" + selection.device + "\" (known: " + KnownDeviceNames() + ")");
   }
-  return info->create(DeviceOptions{selection.eds});
+  return info->create(DeviceOptions{.eds = selection.eds, .ports = info->ports});
 }
 
 }  // namespace canfleet::devices

@@ -1,16 +1,21 @@
 #pragma once
-/// @file The variants `canfleet-node --device NAME` can run, and the choice between a variant and
-/// the generic `--eds FILE` node. Adding a variant: its folder (see README.md), one line in
-/// registry.cpp, one dependency in CMakeLists.txt.
+/// @file The catalog of variants `canfleet-node --device NAME` can run: one data-only entry per
+/// product holding its static facts (name, summary, CAN ports, the manual's factory node-ID and bit
+/// rate, its EDS and its simulated signals) and how to create its behaviour. canfleet-node, the
+/// topology loader and the CLI all read these entries, so each fact is stated once. Adding a
+/// variant: its folder (see README.md) and one entry in registry.cpp.
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "node/canopen/od/object_dictionary.hpp"
 #include "node/devices/device.hpp"
 
 namespace canfleet::devices {
@@ -18,16 +23,35 @@ namespace canfleet::devices {
 struct DeviceInfo {
   std::string_view name;     ///< the --device value
   std::string_view summary;  ///< one line for --list-devices
-  std::size_t ports = 1;     ///< CAN ports the node needs
-  std::function<std::unique_ptr<Device>(const DeviceOptions&)> create;
+  std::size_t ports = 1;     ///< CAN ports of the product (the data logger has 2)
+  /// The node-ID and bit rate the product leaves the factory with (its manual), used when a
+  /// topology or the command line names none.
+  std::uint8_t factory_node_id = 127;
+  std::uint32_t factory_bit_rate_kbit = 125;
+  std::string_view eds_file_name;   ///< "quad-controller.eds", for messages and --write-eds
+  std::string_view (*eds_text)();   ///< the EDS generated from the variant's dictionary table
+  void (*declare_signals)(SimulatedIo&);  ///< declares the simulated I/O into an empty SimulatedIo
+  std::unique_ptr<Device> (*create)(const DeviceOptions&);
 };
 
 /// Every variant, in listing order.
 std::span<const DeviceInfo> Devices();
 /// The variant called `name`, or null.
 const DeviceInfo* FindDevice(std::string_view name);
-/// --list-devices: one line per variant ("quad-controller  1 port  Axiomatic ...").
+/// --list-devices: one line per variant ("quad-controller  1 port   id 127 @ 125 kbit/s  Axiomatic ...").
 std::string ListDevices();
+/// The known names, comma separated, for messages.
+std::string KnownDeviceNames();
+
+/// A variant's simulated signals without creating the device (topology checks).
+std::unique_ptr<SimulatedIo> SignalsOf(const DeviceInfo& info);
+
+/// The dictionary of one port of a variant: its own EDS, or `eds` (a user's copy) when given.
+/// @throws canopen::EdsError
+canopen::ObjectDictionary VariantDictionary(const DeviceInfo& info, const std::filesystem::path& eds = {});
+
+/// CiA 305 table 0 index of a bit rate (1000 → 0, 125 → 4, 10 → 8); nullopt if it has none.
+std::optional<std::uint8_t> BitTimingIndexOf(std::uint32_t kbit);
 
 /// What the command line asked for.
 struct DeviceSelection {

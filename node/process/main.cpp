@@ -13,6 +13,7 @@
 #include "bus/broker_client/broker_client_port.hpp"
 #include "bus/socketcan/socketcan_port.hpp"
 #include "clock/asio_scheduler.hpp"
+#include "node/canopen/storage/atomic_file.hpp"
 #include "node/devices/device_node.hpp"
 #include "node/devices/registry.hpp"
 #include "node/process/node_options.hpp"
@@ -103,9 +104,13 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   };
   std::vector<std::unique_ptr<BusPort>> ports;
   std::vector<BusPort*> raw_ports;
+  // A variant left unconfigured boots as it leaves the factory (its manual's node-ID and bit rate).
+  const devices::DeviceInfo* variant = devices::FindDevice(options.device);
+  const std::uint8_t bit_timing =
+      variant ? devices::BitTimingIndexOf(variant->factory_bit_rate_kbit).value_or(4) : std::uint8_t{4};
   for (std::size_t p = 0; p < port_count; ++p) {
     auto id = options.node_ids.size() == 1 ? options.node_ids[0] : options.node_ids[p];
-    settings.ports.push_back({id, 4});
+    settings.ports.push_back({id, bit_timing});
     ports.push_back(MakePort(io, options.buses[p], options, id, log, start_when_all_connected));
     raw_ports.push_back(ports.back().get());
   }
@@ -143,6 +148,23 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   return 0;
 }
 
+// --write-eds: the EDS a user loads into their own master, exactly the one the node runs on.
+int WriteEds(const std::string& device, const std::string& path) {
+  const devices::DeviceInfo* variant = devices::FindDevice(device);
+  if (variant == nullptr) {
+    throw std::invalid_argument("--write-eds needs --device NAME (known: " + devices::KnownDeviceNames() + ")");
+  }
+  const std::string_view text = variant->eds_text();
+  if (path == "-") {
+    std::cout << text;
+    return 0;
+  }
+  const auto bytes = std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
+  if (const std::error_code ec = canopen::WriteFileAtomically(path, bytes))
+    throw std::invalid_argument("--write-eds " + path + ": " + ec.message());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -152,10 +174,13 @@ int main(int argc, char** argv) {
   std::vector<int> node_ids;
   std::uint32_t serial = 0;
   bool list = false, version = false;
+  std::string write_eds;
   app.add_option("--device", options.device, "device variant (see --list-devices)");
   app.add_option("--eds", options.eds, "EDS file: a generic CiA 301 slave, or replaces the variant's EDS")
       ->check(CLI::ExistingFile);
-  app.add_option("--node-id", node_ids, "node-ID 1..127, or 255 for an unconfigured LSS slave; one per port")
+  app.add_option("--node-id", node_ids,
+                 "node-ID 1..127, or 255 for an unconfigured LSS slave; one per port (default: the variant's "
+                 "factory node-ID, see --list-devices)")
       ->check(CLI::Range(1, 255));
   app.add_option("--bus", buses, "BUS@tcp://HOST:PORT, BUS@unix:///PATH or socketcan:IFACE; one per port");
   app.add_option("--state-dir", options.state_dir, "folder for stored parameters (1010h) and LSS settings");
@@ -167,6 +192,7 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--list-devices", list, "list the device variants and exit");
+  app.add_option("--write-eds", write_eds, "write the --device variant's EDS to FILE (- for stdout) and exit");
   app.add_flag("--version", version, "print the version and exit");
   canfleet::node::TelemetrySettings telemetry;
   canfleet::node::AddTelemetryOptions(app, telemetry);
@@ -187,9 +213,14 @@ int main(int argc, char** argv) {
     return 0;
   }
   try {
+    if (!write_eds.empty()) return WriteEds(options.device, write_eds);
     if (options.device.empty() && options.eds.empty()) throw std::invalid_argument("give --device or --eds");
     if (buses.empty()) throw std::invalid_argument("give at least one --bus");
-    if (node_ids.empty()) throw std::invalid_argument("give --node-id");
+    if (node_ids.empty()) {
+      const auto* variant = canfleet::devices::FindDevice(options.device);
+      if (variant == nullptr) throw std::invalid_argument("give --node-id (a generic node has no factory node-ID)");
+      node_ids.push_back(variant->factory_node_id);
+    }
     for (const auto& b : buses)
       options.buses.push_back(canfleet::node::ParseBusSpec(b));
     for (int id : node_ids) {

@@ -21,6 +21,7 @@
 #include "node/canopen/eds/eds_error.hpp"
 #include "node/canopen/eds/eds_reader.hpp"
 #include "node/canopen/od/object_dictionary.hpp"
+#include "node/devices/eds_dictionary.hpp"
 #include "node/devices/registry.hpp"
 #include "orchestrator/control/sdo_value.hpp"
 
@@ -242,7 +243,8 @@ struct NodeFacts {
   fs::path state_dir;                 // resolved
   fs::path eds;                       // resolved, or empty
   fs::path dcf;                       // resolved, or empty
-  devices::Device* device = nullptr;  // a scratch instance (Loader::devices_): its simulated I/O
+  const devices::DeviceInfo* variant = nullptr;  // the catalog entry, or null for a generic node
+  devices::SimulatedIo* io = nullptr;  // the variant's signals (Loader::signals_): io checks set them
   std::shared_ptr<const std::vector<canopen::ObjectDictionary>> dictionaries;  // one per port
   std::uint32_t producer_ms = 0;
 
@@ -458,7 +460,7 @@ class Loader {
 
   void CheckDevice(const Scope& s, const Node& node, NodeFacts& facts) {
     if (node.device().empty() && node.eds().empty())
-      s.FailHere("node " + node.name() + " needs device (a variant: " + KnownDevices() +
+      s.FailHere("node " + node.name() + " needs device (a variant: " + devices::KnownDeviceNames() +
                  ") or eds (an EDS file for a generic node)");
     if (!node.eds().empty()) {
       facts.eds = Resolve(node.eds());
@@ -476,19 +478,20 @@ class Loader {
     if (!node.device().empty()) {
       const devices::DeviceInfo* info = devices::FindDevice(node.device());
       if (info == nullptr)
-        s.Fail("device", "unknown device " + Quote(node.device()) + " (known: " + KnownDevices() + ")");
+        s.Fail("device", "unknown device " + Quote(node.device()) + " (known: " + devices::KnownDeviceNames() + ")");
       facts.ports = info->ports;
       facts.kind = std::string(info->name);
+      facts.variant = info;
     } else {
       facts.ports = 1;
       facts.kind = "generic node (" + facts.eds.filename().string() + ")";
     }
-    // A scratch instance of the device: its simulated I/O and its dictionaries check io and sdo.
+    // The catalog's signals and dictionaries check io and sdo; no device is created for that.
     try {
-      std::unique_ptr<devices::Device>& device = devices_[node.device() + "\n" + facts.eds.string()];
-      if (!device) device = devices::MakeDevice({node.device(), facts.eds});
-      facts.device = device.get();
-      facts.dictionaries = Dictionaries(*facts.device, facts.ports, node.device(), facts.eds);
+      std::unique_ptr<devices::SimulatedIo>& io = signals_[node.device()];
+      if (!io) io = facts.variant ? devices::SignalsOf(*facts.variant) : std::make_unique<devices::SimulatedIo>();
+      facts.io = io.get();
+      facts.dictionaries = Dictionaries(facts.variant, facts.ports, facts.eds);
     } catch (const std::exception& e) {
       s.Fail(node.eds().empty() ? "device" : "eds", e.what());
     }
@@ -499,11 +502,11 @@ class Loader {
   // is compiled in; an EDS file is known by its path, size and modification time, so an edited
   // file is read again.
   static std::shared_ptr<const std::vector<canopen::ObjectDictionary>> Dictionaries(
-      devices::Device& device, std::size_t ports, const std::string& variant, const fs::path& eds) {
+      const devices::DeviceInfo* variant, std::size_t ports, const fs::path& eds) {
     static std::mutex mutex;
     static std::map<std::string, std::shared_ptr<const std::vector<canopen::ObjectDictionary>>> built;
     constexpr std::size_t kMaxBuilt = 64;
-    std::string key = variant;
+    std::string key = variant ? std::string(variant->name) : std::string();
     if (!eds.empty()) {
       std::error_code size_error, time_error;
       const auto size = fs::file_size(eds, size_error);
@@ -520,7 +523,7 @@ class Loader {
     }
     auto dictionaries = std::make_shared<std::vector<canopen::ObjectDictionary>>(ports);
     for (std::size_t p = 0; p < ports; ++p)
-      device.Build(p, (*dictionaries)[p]);
+      (*dictionaries)[p] = variant ? devices::VariantDictionary(*variant, eds) : devices::DictionaryFromEdsFile(eds);
     if (!key.empty()) {
       const std::lock_guard lock(mutex);
       if (built.size() >= kMaxBuilt) built.clear();
@@ -539,12 +542,6 @@ class Loader {
       s.Fail(field, Quote(given) + ": not a regular file (" + resolved.string() + ")");
   }
 
-  static std::string KnownDevices() {
-    std::string out;
-    for (const devices::DeviceInfo& d : devices::Devices())
-      out += (out.empty() ? "" : ", ") + std::string(d.name);
-    return out;
-  }
 
   void CheckBusesOfNode(const Scope& s, const Node& node, NodeFacts& facts) {
     if (node.bus_size() == 0)
@@ -629,7 +626,7 @@ class Loader {
     if (!LooksLikeSignalName(name))
       s.Fail(name_field, Quote(name) + " is not a signal name (CHANNEL.quantity, e.g. AIN1.voltage_mV)");
     if (value.empty()) s.Fail(value_field, "required: the value to set " + name + " to");
-    devices::SimulatedIo& io = facts.device->io();
+    devices::SimulatedIo& io = *facts.io;
     const devices::IoSignal* signal = io.Find(name);
     if (signal == nullptr) {
       if (io.Signals().empty())
@@ -937,7 +934,7 @@ class Loader {
   std::vector<NodeFacts> nodes_;
   // One scratch device per variant and EDS, shared by the nodes that use it: io checks only ask
   // whether a value would be accepted, and building a device per node is most of a load's time.
-  std::map<std::string, std::unique_ptr<devices::Device>> devices_;
+  std::map<std::string, std::unique_ptr<devices::SimulatedIo>> signals_;
   std::map<std::pair<int, int>, std::uint32_t> consumer_ids_;  // (node index, consumer index) -> node-ID
 };
 

@@ -35,4 +35,5 @@ python="$(printf '%s\n' "$env_out" | tail -n 1)"
 cd "$here"
 export PYTHONDONTWRITEBYTECODE=1  # no __pycache__ in the source tree
 echo "conformance: $("$python" -c 'import canopen, can; print(f"python-canopen {canopen.__version__}, python-can {can.__version__}")'), binaries from $build/bin"
+export CANFLEET_BUILD_DIR="$build"
 exec "$python" -m pytest "--build-dir=$build" "$@"

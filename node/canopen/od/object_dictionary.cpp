@@ -34,6 +34,7 @@ Object& ObjectDictionary::Add(Object object) {
     if (sub.value.empty()) sub.value = sub.default_value;
   }
   auto index = object.index;
+  borrowed_.erase(index);
   objects_.insert_or_assign(index, std::move(object));
   return objects_.at(index);
 }
@@ -49,13 +50,20 @@ SubObject& ObjectDictionary::AddVar(std::uint16_t index, std::string name, DataT
 }
 
 Object* ObjectDictionary::Find(std::uint16_t index) {
-  auto it = objects_.find(index);
-  return it == objects_.end() ? nullptr : &it->second;
+  if (auto it = objects_.find(index); it != objects_.end()) return &it->second;
+  auto it = borrowed_.find(index);
+  return it == borrowed_.end() ? nullptr : it->second;
 }
 
 const Object* ObjectDictionary::Find(std::uint16_t index) const {
-  auto it = objects_.find(index);
-  return it == objects_.end() ? nullptr : &it->second;
+  if (auto it = objects_.find(index); it != objects_.end()) return &it->second;
+  auto it = borrowed_.find(index);
+  return it == borrowed_.end() ? nullptr : it->second;
+}
+
+void ObjectDictionary::Borrow(Object& object) {
+  objects_.erase(object.index);
+  borrowed_.insert_or_assign(object.index, &object);
 }
 
 SubObject* ObjectDictionary::Find(std::uint16_t index, std::uint8_t sub) {

@@ -110,13 +110,25 @@ class ObjectDictionary {
 
   /// Restores the defaults of every object with index in [first, last] (reset node: 1000h–FFFFh;
   /// reset communication: 1000h–1FFFh), applying `node_id` to "$NODEID" defaults. Listeners run.
+  /// Borrowed objects are left alone: their owner restores them.
   void RestoreDefaults(std::uint16_t first, std::uint16_t last, std::uint8_t node_id);
 
+  /// Serves `object`, owned by another dictionary, at its index (replacing an own object there):
+  /// one object seen through two dictionaries, as the application objects of a device with two
+  /// CAN ports (data logger UMAX181001 §1.1: "2 CAN interfaces which share manufacturer-specific
+  /// objects"). Find, Lookup, Read and Write reach it; objects(), RestoreDefaults and therefore
+  /// storage (ParameterStore) do not: they are the owner's, so a reset or a restore of this
+  /// dictionary never touches the shared values. The owner must outlive this dictionary.
+  void Borrow(Object& object);
+  bool IsBorrowed(std::uint16_t index) const { return borrowed_.contains(index); }
+
+  /// The objects this dictionary owns (borrowed ones are not listed).
   const Objects& objects() const { return objects_; }
   Objects& objects() { return objects_; }
 
  private:
   Objects objects_;
+  std::map<std::uint16_t, Object*> borrowed_;
 };
 
 }  // namespace canfleet::canopen

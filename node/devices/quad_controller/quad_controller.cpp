@@ -7,7 +7,8 @@
 
 namespace canfleet::devices {
 
-QuadController::QuadController(DeviceOptions options) : options_(std::move(options)), signals_(io_) {}
+QuadController::QuadController(DeviceOptions options)
+    : Device(options.ports), options_(std::move(options)), signals_(io_) {}
 
 QuadController::~QuadController() = default;
 

@@ -2,6 +2,10 @@
 // device with two CAN ports sharing its application objects (the data logger's shape, UMAX181001
 // §1.1), DeviceNode's checks and the per-unit serial number.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
 
 #include "bus/loopback_bus.hpp"
 #include "node/canopen/stack/standard_objects.hpp"
@@ -10,7 +14,6 @@
 #include "node/devices/od_ref.hpp"
 #include "node/devices/periodic_tick.hpp"
 #include "node/devices/quad_controller/quad_controller.hpp"
-#include "node/devices/shared_objects.hpp"
 #include "tests/support/bus_probe.hpp"
 
 namespace canfleet::devices {
@@ -95,11 +98,13 @@ TEST_F(DelayedFaultTest, GoneWhilePendingOrResetLeavesNoTrace) {
 }
 
 // A device with two CAN ports: each port has its own communication objects and NMT state; the
-// application objects (2000h-FFFFh) are shared, the first port's dictionary holding the rules.
+// application objects (2000h-FFFFh) are one set, owned by the first port's dictionary and borrowed
+// by the second's (the data logger's shape, UMAX181001 §1.1).
 class TwoPortDevice final : public Device {
  public:
+  TwoPortDevice() : Device(2) {}
   std::string_view Name() const override { return "two-port"; }
-  std::size_t PortCount() const override { return 2; }
+  std::optional<ObjectRange> SharedObjects() const override { return ObjectRange{0x2000, 0xFFFF}; }
   void Build(std::size_t port, canopen::ObjectDictionary& od) override {
     (void)port;
     canopen::AddStandardObjects(od, {});
@@ -108,60 +113,126 @@ class TwoPortDevice final : public Device {
     od.AddVar(0x6000, "Measured", canopen::DataType::kUnsigned8, canopen::Access::kRo, {0}, true);
   }
   void Attach(DeviceContext& context) override {
-    auto& primary = context.stacks[0]->od();
-    shared = std::make_unique<SharedObjects>(primary, context.stacks[1]->od(), 0x2000, 0xFFFF);
-    primary.Find(0x2000, 0)->validators.push_back(
+    auto& od = context.stacks[0]->od();
+    od.Find(0x2000, 0)->validators.push_back(
         [](const canopen::SubObject&, std::span<const std::uint8_t> d, canopen::Origin) {
           return d[0] % 2 == 0 ? canopen::SdoAbort::kNone : canopen::SdoAbort::kInvalidValue;
         });
-    primary.Find(0x2000, 0)->listeners.push_back([this](canopen::SubObject&, canopen::Origin) { ++changes; });
-    measured = OdRef(primary, 0x6000, 0);
+    od.Find(0x2000, 0)->listeners.push_back([this](canopen::SubObject&, canopen::Origin) { ++changes; });
+    measured = OdRef(od, 0x6000, 0);
   }
-  std::unique_ptr<SharedObjects> shared;
   OdRef measured;
   int changes = 0;
 };
 
 class TwoPortTest : public ::testing::Test {
  protected:
-  TwoPortTest()
-      : node_(std::make_unique<TwoPortDevice>(), scheduler_, {&port1_, &port2_},
-              NodeSettings{{PortSettings{3, 4}, PortSettings{4, 4}}, {}, {}, {}}) {
-    node_.Start();
+  explicit TwoPortTest(std::filesystem::path state_dir = {}) : state_dir_(std::move(state_dir)) { Boot(); }
+  void Boot() {
+    node_.reset();
+    node_ = std::make_unique<DeviceNode>(std::make_unique<TwoPortDevice>(), scheduler_,
+                                         std::vector<BusPort*>{&port1_, &port2_},
+                                         NodeSettings{{PortSettings{3, 4}, PortSettings{4, 4}}, state_dir_, {}, {}});
+    node_->Start();
     can1_.Clear();
     can2_.Clear();
   }
-  TwoPortDevice& device() { return static_cast<TwoPortDevice&>(node_.device()); }
+  TwoPortDevice& device() { return static_cast<TwoPortDevice&>(node_->device()); }
+  std::filesystem::path state_dir_;
   SimulatedScheduler scheduler_;
   LoopbackBus bus1_, bus2_;
   LoopbackPort& port1_ = bus1_.Attach("node");
   LoopbackPort& port2_ = bus2_.Attach("node");
   canfleet::test::BusProbe can1_{bus1_, "master1"};
   canfleet::test::BusProbe can2_{bus2_, "master2"};
-  DeviceNode node_;
+  std::unique_ptr<DeviceNode> node_;
 };
 
-TEST_F(TwoPortTest, ApplicationObjectsAreSharedAndRulesApplyOnBothPorts) {
-  EXPECT_EQ(node_.PortCount(), 2u);
-  EXPECT_GT(device().shared->Count(), 0u);
+TEST_F(TwoPortTest, ApplicationObjectsAreOneObjectAndRulesApplyOnBothPorts) {
+  EXPECT_EQ(node_->PortCount(), 2u);
+  EXPECT_TRUE(node_->od(1).IsBorrowed(0x2000));
+  EXPECT_EQ(node_->od(1).Find(0x2000, 0), node_->od(0).Find(0x2000, 0));  // one object, not a copy
+  EXPECT_FALSE(node_->od(1).IsBorrowed(0x1017));                          // communication: per port
   can2_.Send("604#2B00200008000000");  // port 2, node 4: 2000h = 8
   EXPECT_EQ(can2_.Next(), "584#6000200000000000");
   EXPECT_EQ(device().changes, 1);
   can1_.Send("603#4000200000000000");
   EXPECT_EQ(can1_.Next(), "583#4B00200008000000");
-  can2_.Send("604#2B00200007000000");  // odd: the primary's validator refuses
+  can2_.Send("604#2B00200007000000");  // odd: the device's validator refuses on either port
   EXPECT_EQ(can2_.Next(), "584#8000200030000906");
-  device().measured.Set(0x5A);  // a block writes the primary
+  device().measured.Set(0x5A);  // a block writes the device's object
   can2_.Send("604#4000600000000000");
   EXPECT_EQ(can2_.Next(), "584#4F0060005A000000");
 }
 
 TEST_F(TwoPortTest, EachPortHasItsOwnNmtState) {
   can1_.Send("000#0203");  // stop port 1's node
-  EXPECT_EQ(node_.stack(0).State(), NmtState::kStopped);
-  EXPECT_EQ(node_.stack(1).State(), NmtState::kPreOperational);
+  EXPECT_EQ(node_->stack(0).State(), NmtState::kStopped);
+  EXPECT_EQ(node_->stack(1).State(), NmtState::kPreOperational);
   can2_.Send("604#4000100000000000");
   EXPECT_EQ(can2_.Next().substr(0, 6), "584#43");
+}
+
+// A reset node on one port restores that port's communication objects; the device's shared
+// objects are not that port's to reset (they belong to the device, port 1's dictionary).
+TEST_F(TwoPortTest, AResetOfPortTwoLeavesTheSharedObjects) {
+  can2_.Send("604#2B00200008000000");
+  EXPECT_EQ(can2_.Next(), "584#6000200000000000");
+  can2_.Send("000#8104");  // reset node, port 2
+  can2_.Send("604#4000200000000000");
+  can2_.Take();
+  can1_.Send("603#4000200000000000");
+  EXPECT_EQ(can1_.Next(), "583#4B00200008000000");
+}
+
+// UMAX181001 §3.2.10/§3.2.11: "save" or "load" on either bus applies to the device. A power-on
+// restores what was stored, whichever port stored it, and the second port's power-on never puts
+// its defaults over the first port's restored values.
+class TwoPortStorageTest : public TwoPortTest {
+ protected:
+  TwoPortStorageTest() : TwoPortTest(MakeDir()) {}
+  ~TwoPortStorageTest() override { std::filesystem::remove_all(state_dir_); }
+  static std::filesystem::path MakeDir() {
+    auto dir = std::filesystem::temp_directory_path() /
+               ("canfleet-twoport-" + std::to_string(::getpid()) + "-" +
+                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir);
+    return dir;
+  }
+  std::string Read2000(canfleet::test::BusProbe& can, const char* request) {
+    can.Send(request);
+    return can.Next();
+  }
+};
+
+TEST_F(TwoPortStorageTest, StoredOnPortOneSurvivesPowerOn) {
+  can1_.Send("603#2B00200008000000");
+  EXPECT_EQ(can1_.Next(), "583#6000200000000000");
+  can1_.Send("603#2310100173617665");  // 1010h sub 1 "save"
+  EXPECT_EQ(can1_.Next(), "583#6010100100000000");
+  Boot();
+  EXPECT_EQ(Read2000(can2_, "604#4000200000000000"), "584#4B00200008000000");
+  EXPECT_EQ(Read2000(can1_, "603#4000200000000000"), "583#4B00200008000000");
+}
+
+TEST_F(TwoPortStorageTest, StoredOnPortTwoCoversTheSharedObjects) {
+  can2_.Send("604#2B0020000A000000");
+  EXPECT_EQ(can2_.Next(), "584#6000200000000000");
+  can2_.Send("604#2310100473617665");  // 1010h sub 4 "save" manufacturer objects, port 2
+  EXPECT_EQ(can2_.Next(), "584#6010100400000000");
+  Boot();
+  EXPECT_EQ(Read2000(can1_, "603#4000200000000000"), "583#4B0020000A000000");
+}
+
+TEST_F(TwoPortStorageTest, RestoreOnPortTwoBringsBackTheDefaultsAfterAReset) {
+  can1_.Send("603#2B0020000C000000");
+  EXPECT_EQ(can1_.Next(), "583#6000200000000000");
+  can1_.Send("603#2310100173617665");
+  EXPECT_EQ(can1_.Next(), "583#6010100100000000");
+  can2_.Send("604#231110016C6F6164");  // 1011h sub 1 "load", port 2
+  EXPECT_EQ(can2_.Next(), "584#6011100100000000");
+  Boot();
+  EXPECT_EQ(Read2000(can1_, "603#4000200000000000"), "583#4B00200002000000");
 }
 
 TEST(DeviceNodeTest, RefusesAWrongNumberOfPorts) {
@@ -185,6 +256,90 @@ TEST(DeviceNodeTest, SerialNumberOverridesTheEds) {
   master.Clear();
   master.Send("605#4018100400000000");
   EXPECT_EQ(master.Next(), "585#4318100478563412");
+}
+
+}  // namespace
+}  // namespace canfleet::devices
+
+namespace canfleet::devices {
+namespace {
+
+// A device that uses the port hooks of the framework (issue 15 point 7): it counts every frame it
+// sees before the stack, mutes the stack while "asleep" and speaks for itself.
+class HookDevice final : public Device {
+ public:
+  std::string_view Name() const override { return "hooks"; }
+  void Build(std::size_t, canopen::ObjectDictionary& od) override {
+    canopen::AddStandardObjects(od, {});
+    od.Find(0x1017, 0)->default_value = canopen::EncodeLe<std::uint16_t>(100);  // heartbeat every 100 ms
+  }
+  void Attach(DeviceContext& context) override {
+    port = context.ports.at(0);
+    port->ObserveFrames([this](const CanFrame&) { ++seen; });
+  }
+  DevicePort* port = nullptr;
+  int seen = 0;
+};
+
+TEST(DevicePortTest, ADeviceSeesFramesFirstMutesItsStackAndSendsItself) {
+  SimulatedScheduler scheduler;
+  LoopbackBus bus;
+  LoopbackPort& raw = bus.Attach("node");
+  canfleet::test::BusProbe can{bus, "master"};
+  DeviceNode node(std::make_unique<HookDevice>(), scheduler, {&raw}, NodeSettings{{PortSettings{5, 4}}, {}, {}, {}});
+  auto& device = static_cast<HookDevice&>(node.device());
+  node.Start();
+  EXPECT_EQ(can.Next(), "705#00");  // boot-up
+  can.Send("000#0105");             // NMT start node 5: seen by the device, then by the stack
+  EXPECT_EQ(device.seen, 1);
+  EXPECT_EQ(node.stack().State(), NmtState::kOperational);
+  scheduler.Advance(100ms);
+  EXPECT_EQ(can.Next(), "705#05");  // heartbeat, operational
+  device.port->SetMuted(true);      // asleep: the stack's heartbeats stay off the bus
+  scheduler.Advance(300ms);
+  EXPECT_EQ(can.Count(), 0u);
+  EXPECT_TRUE(device.port->SendFromDevice(CanFrame::Data(0x000, {0x01, 0x00})));  // the device's own NMT Start
+  EXPECT_EQ(can.Next(), "000#0100");
+  device.port->SetMuted(false);
+  scheduler.Advance(100ms);
+  EXPECT_EQ(can.Next(), "705#05");
+}
+
+}  // namespace
+}  // namespace canfleet::devices
+
+namespace canfleet::devices {
+namespace {
+
+// REAL32 objects (the family's constants 5010h, supply voltage 5020h, current-loop gains 2382h)
+// are numbers to the blocks; integers take numbers rounded and saturated, never wrapped.
+TEST(OdRefTest, RealsAndIntegersAsNumbers) {
+  canopen::ObjectDictionary od;
+  od.AddVar(0x5020, "Power Supply FV", canopen::DataType::kReal32, canopen::Access::kRo, canopen::EncodeLe(24.5f));
+  od.AddVar(0x2460, "PID Output FV", canopen::DataType::kInteger16, canopen::Access::kRo, canopen::EncodeLe<std::int16_t>(0));
+  od.AddVar(0x2000, "Level", canopen::DataType::kUnsigned8, canopen::Access::kRo, {0});
+  const OdRef supply(od, 0x5020, 0);
+  const OdRef pid(od, 0x2460, 0);
+  const OdRef level(od, 0x2000, 0);
+  EXPECT_TRUE(supply.IsReal());
+  EXPECT_DOUBLE_EQ(supply.GetNumber(), 24.5);
+  EXPECT_EQ(supply.Get(), 25);  // rounded
+  EXPECT_TRUE(supply.SetNumber(12.25));
+  EXPECT_DOUBLE_EQ(supply.GetNumber(), 12.25);
+  EXPECT_FALSE(supply.SetNumber(12.25));  // unchanged: no write, no listener
+  EXPECT_TRUE(supply.Set(7));
+  EXPECT_DOUBLE_EQ(supply.GetNumber(), 7.0);
+  EXPECT_TRUE(pid.SetNumber(999.6));
+  EXPECT_EQ(pid.Get(), 1000);
+  EXPECT_TRUE(pid.SetNumber(-1e9));
+  EXPECT_EQ(pid.Get(), -32768);
+  EXPECT_TRUE(level.SetNumber(300));
+  EXPECT_EQ(level.Get(), 255);
+  EXPECT_TRUE(level.SetNumber(-4));
+  EXPECT_EQ(level.Get(), 0);
+  EXPECT_FALSE(level.SetNumber(std::nan("")));
+  od.AddVar(0x1008, "Name", canopen::DataType::kVisibleString, canopen::Access::kConst, canopen::ToBytes("x"));
+  EXPECT_THROW(OdRef(od, 0x1008, 0), std::logic_error);
 }
 
 }  // namespace

@@ -92,7 +92,7 @@ TEST(DeviceRegistryTest, ListsTheQuadAndExplainsBadSelections) {
   EXPECT_NE(FindDevice("quad-controller"), nullptr);
   EXPECT_EQ(FindDevice("quad"), nullptr);
   const std::string list = ListDevices();
-  EXPECT_NE(list.find("quad-controller  1 port   Axiomatic CANopen Quad Controller AX020506"),
+  EXPECT_NE(list.find("quad-controller  1 port   id 127 @ 125 kbit/s   Axiomatic CANopen Quad Controller AX020506"),
             std::string::npos)
       << list;
   try {
@@ -124,6 +124,36 @@ TEST(DeviceRegistryTest, AMissingEdsFileIsReported) {
   LoopbackBus bus;
   LoopbackPort& port = bus.Attach("node");
   EXPECT_THROW(DeviceNode(MakeDevice({"", "/nonexistent/x.eds"}), scheduler, {&port}, {}), canopen::EdsError);
+}
+
+}  // namespace
+}  // namespace canfleet::devices
+
+namespace canfleet::devices {
+namespace {
+
+// The catalog entry is the one place for a variant's static facts: the signals and the dictionary
+// the topology loader checks against come from it without creating the device, and a device made
+// from it has the entry's port count.
+TEST(DeviceCatalogTest, AnEntryGivesSignalsDictionaryAndPortsWithoutADevice) {
+  const DeviceInfo* quad = FindDevice("quad-controller");
+  ASSERT_NE(quad, nullptr);
+  const auto signals = SignalsOf(*quad);
+  ASSERT_NE(signals->Find("AIN1.voltage_mV"), nullptr);
+  EXPECT_EQ(signals->Find("POUT1.current_mA")->direction(), IoDirection::kOutput);
+  const canopen::ObjectDictionary od = VariantDictionary(*quad);
+  EXPECT_EQ(od.GetUnsigned(0x1018, 2), 0xAA020502u);  // AX020506 §3.1, 1018h sub 2
+  EXPECT_EQ(MakeDevice({"quad-controller", {}})->PortCount(), quad->ports);
+  EXPECT_EQ(quad->eds_text().substr(0, 10), "[FileInfo]");
+}
+
+// CiA 305 §5.5 table 0: the bit timing index of each bit rate; 100 kbit/s (index 5) is reserved.
+TEST(DeviceCatalogTest, BitTimingIndexesFollowCia305Table0) {
+  EXPECT_EQ(BitTimingIndexOf(1000), 0);
+  EXPECT_EQ(BitTimingIndexOf(125), 4);
+  EXPECT_EQ(BitTimingIndexOf(10), 8);
+  EXPECT_EQ(BitTimingIndexOf(100), std::nullopt);
+  EXPECT_EQ(BitTimingIndexOf(333), std::nullopt);
 }
 
 }  // namespace
