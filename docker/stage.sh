@@ -2,7 +2,7 @@
 # Build stage of docker/Dockerfile: builds the shipped executables and stages what the runtime
 # image holds under OUT:
 #   OUT/bin/                    every executable named `canfleet` or `canfleet-*` (stripped)
-#   OUT/share/canfleet/         topologies/, devices/<variant>/*.eds, telemetry/*.xml
+#   OUT/share/canfleet/         topologies/, devices/<variant>/<variant>.eds (canfleet-node --write-eds), telemetry/*.xml
 #   OUT/etc/canfleet/           telemetry/*.xml again (the Cyclone DDS configs)
 #   OUT/runtime-packages.txt    the Debian packages owning the shared libraries they link
 # Shipped executables follow the naming convention `canfleet[-<name>]` (tests and benchmarks use
@@ -50,7 +50,13 @@ if [ -d "$src/topologies" ]; then
   mkdir -p "$share/topologies"
   (cd "$src/topologies" && find . -type f ! -name 'README*' ! -name 'CMakeLists.txt' -exec cp --parents {} "$share/topologies/" \;)
 fi
-(cd "$src/node" 2>/dev/null && find devices -type f -iname '*.eds' -exec cp --parents {} "$share/" \;) || true
+# Each variant's EDS, exactly the one its node runs on (generated from its dictionary table).
+if [ -x "$out/bin/canfleet-node" ]; then
+  for variant in $("$out/bin/canfleet-node" --list-devices | awk '{print $1}'); do
+    mkdir -p "$share/devices/$variant"
+    "$out/bin/canfleet-node" --device "$variant" --write-eds "$share/devices/$variant/$variant.eds"
+  done
+fi
 if compgen -G "$src/telemetry/*.xml" >/dev/null; then
   mkdir -p "$share/telemetry" && cp "$src"/telemetry/*.xml "$share/telemetry/" && cp "$src"/telemetry/*.xml "$out/etc/canfleet/"
 fi
