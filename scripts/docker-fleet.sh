@@ -12,6 +12,8 @@
 #   scripts/docker-fleet.sh network                      prints the fleet's network name
 #   scripts/docker-fleet.sh down                         compose down -v (containers, network, volumes)
 #   scripts/docker-fleet.sh compose ARGS...              any compose command (ps, logs, stop quad-5, ...)
+#   scripts/docker-fleet.sh --swarm COMMAND ...          the fleet as a swarm stack, sharded by bus:
+#                                                        scripts/docker-swarm.sh (up, scale, status, top, down...)
 #
 # Environment: CANFLEET_PROJECT (compose project, default canfleet), CANFLEET_IMAGE (canfleet:dev),
 # CANFLEET_CONTROL_PORT (29700), CANFLEET_BROKER_PORT (29600), CANFLEET_CAN0_PORT (29536),
@@ -21,6 +23,10 @@
 # Exit codes: 0 done, 1 failed or timed out, 2 usage, 3 no compose tool or no Docker engine.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
+if [ "${1:-}" = --swarm ]; then
+  shift
+  exec "$repo/scripts/docker-swarm.sh" "$@"
+fi
 
 export CANFLEET_PROJECT="${CANFLEET_PROJECT:-canfleet}"
 export CANFLEET_IMAGE="${CANFLEET_IMAGE:-canfleet:dev}"

@@ -312,3 +312,4 @@ loss_and_back disconnect
 log "checked:"
 for c in "${checks[@]}"; do echo "docker-test:   - $c"; done
 for c in "${unchecked[@]}"; do echo "docker-test:   - NOT CHECKED: $c"; done
+tests/docker/swarm.sh --no-build # the same image as a swarm stack, sharded by bus (SKIPPED where the engine cannot run a swarm)
