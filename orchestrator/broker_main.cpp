@@ -1,6 +1,6 @@
 // canfleet-broker: serves virtual CAN buses to node processes over TCP and Unix-domain sockets.
-// main only wires the Broker, its AsioScheduler, the transport (orchestrator/transport/) and the
-// telemetry (orchestrator/broker_telemetry/: BusStats of every bus over DDS).
+// main only reads its command line: the broker, its scheduler, the transport and the telemetry
+// (BusStats of every bus over DDS) are wired by host::BrokerHost, as for `canfleet up`.
 //
 //   canfleet-broker --bus can0:500k --bus can1:1M:unpaced
 //                   --listen tcp://127.0.0.1:29600 --listen unix:///tmp/canfleet.sock
@@ -12,22 +12,15 @@
 
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
-#include <asio/steady_timer.hpp>
 #include <charconv>
-#include <csignal>
 #include <cstdio>
 #include <fstream>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "bus/wire/endpoint.hpp"
-#include "clock/asio_scheduler.hpp"
-#include "orchestrator/broker/broker.hpp"
-#include "orchestrator/broker_telemetry/broker_telemetry.hpp"
-#include "orchestrator/transport/broker_server.hpp"
+#include "orchestrator/host/broker_host.hpp"
 #include "telemetry/cli_options.hpp"
 
 namespace {
@@ -126,58 +119,25 @@ int main(int argc, char** argv) {
     listens.push_back("tcp://127.0.0.1:" + std::to_string(canfleet::wire::kDefaultBrokerPort));
 
   asio::io_context io(1);
-  canfleet::AsioScheduler scheduler(io);
-  canfleet::broker::Broker broker(scheduler);
-  canfleet::transport::BrokerServer server(io, broker);
-  // Telemetry, destroyed before the broker and the scheduler it samples (declared after them).
-  std::optional<canfleet::telemetry::Participant> participant;
-  std::optional<canfleet::telemetry::OrchestratorTelemetry> publisher;
-  std::optional<canfleet::broker::BrokerTelemetry> telemetry;
+  canfleet::host::BrokerHost host(io);
   try {
-    for (const auto& spec : bus_specs) {
-      const BusConfig config = ParseBus(spec);
-      broker.AddBus(config);
-      spdlog::info("bus {}: {} bit/s, {}", config.name, config.bitrate, config.paced ? "paced" : "unpaced");
-    }
+    for (const auto& spec : bus_specs)
+      host.AddBus(ParseBus(spec));
     for (const auto& text : listens)
-      server.Listen(canfleet::wire::Endpoint::Parse(text));
-    if (telemetry_enabled) {
-      const auto period = std::chrono::milliseconds(static_cast<long>(telemetry_period * 1000));
-      try {
-        participant.emplace(dds);
-        publisher.emplace(*participant, canfleet::telemetry::OrchestratorTelemetryOptions{.period = period});
-        telemetry.emplace(broker, scheduler, *publisher,
-                          canfleet::broker::BrokerTelemetryOptions{.period = period});
-        spdlog::info("telemetry: BusStats on DDS domain {}", dds.domain_id);
-      } catch (const canfleet::telemetry::DdsError& e) {
-        // The buses matter more than their monitoring: run without telemetry.
-        spdlog::error("telemetry: {}; running without telemetry", e.what());
-        telemetry.reset();
-        publisher.reset();
-        participant.reset();
-      }
-    }
-    if (!ready_file.empty()) WriteReadyFile(ready_file, server.Endpoints());
+      host.Listen(canfleet::wire::Endpoint::Parse(text));
+    if (telemetry_enabled)
+      host.StartTelemetry(dds, std::chrono::milliseconds(static_cast<long>(telemetry_period * 1000)));
+    if (!ready_file.empty()) WriteReadyFile(ready_file, host.Endpoints());
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());
     return 2;
   }
 
-  asio::signal_set signals(io, SIGINT, SIGTERM);
-  asio::steady_timer drain(io);
-  signals.async_wait([&](const asio::error_code& ec, int signal) {
-    if (ec) return;
-    spdlog::info("{}: shutting down", signal == SIGINT ? "SIGINT" : "SIGTERM");
-    server.Close();  // sessions say "broker shutting down" and detach
-    // Let the farewells leave, then stop whatever the broker still has armed.
-    drain.expires_after(std::chrono::milliseconds(200));
-    drain.async_wait([&](const asio::error_code&) { io.stop(); });
+  host.OnSignal([&](const char* signal) {
+    spdlog::info("{}: shutting down", signal);
+    host.Stop();
   });
   io.run();
-  // Dispose the buses' BusStats (monitors drop them) before the process goes.
-  telemetry.reset();
-  publisher.reset();
-  participant.reset();
   spdlog::info("stopped");
   return 0;
 }

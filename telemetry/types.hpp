@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "bus/bus_port.hpp"
-#include "node/canopen/common/nmt_state.hpp"
+#include "vocabulary/nmt_state.hpp"
 
 namespace canfleet::telemetry {
 

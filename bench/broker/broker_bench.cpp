@@ -31,7 +31,7 @@
 #include <thread>
 #include <vector>
 
-#include "bus/frame_timing.hpp"
+#include "bus/physics/frame_timing.hpp"
 #include "bus/wire/message_writer.hpp"
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
@@ -66,7 +66,7 @@ CanFrame EightBytes(std::uint32_t id, std::uint8_t seed) {
 /// Counts deliveries; one designated port (the "pump") submits the next batch for every port when
 /// its own batch is confirmed, so the Asio run is a closed loop with one timer per round.
 /// With `encode`, it also does a TCP/Unix session's work per round: the frames go into a
-/// wire::MessageWriter as transport::detail::Session puts them (copies of the round's records,
+/// wire::MessageWriter as transport::detail::NodeSession puts them (copies of the round's records,
 /// encoded once for all sessions), closed into a message, then dropped.
 class CountingSink : public PortSink {
  public:
@@ -78,7 +78,7 @@ class CountingSink : public PortSink {
     });
     Send();
   }
-  /// With `encode`: what transport::detail::Session does, copies of one encoding of the round.
+  /// With `encode`: what transport::detail::NodeSession does, copies of one encoding of the round.
   /// Without: the default (Deliver), as for a sink that only implements Deliver.
   void DeliverShared(const SharedRound& round, std::span<const FrameRun> runs) override {
     if (!encode) {

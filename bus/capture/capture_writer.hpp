@@ -6,11 +6,12 @@
 #include <string>
 
 #include "bus/can_frame.hpp"
+#include "clock/wall_clock.hpp"
 
 namespace canfleet::capture {
 
-/// Wall-clock time (Unix epoch), as capture files and socketcand clients expect it.
-using WallTime = std::chrono::sys_time<std::chrono::nanoseconds>;
+/// Wall-clock time (Unix epoch), as capture files expect it (clock/wall_clock.hpp).
+using canfleet::WallTime;
 
 /// One capture file being written. Writes are buffered; Flush pushes them to the file, Close
 /// flushes and closes (the destructor closes too). A failed write (disk full...) is not thrown:

@@ -35,7 +35,7 @@ struct Port;
 /// - a transfer occupies the bus for CountFrameBits(frame).total() bit times (an idle bus starts
 ///   it when it is submitted); every other port receives it and the sender gets a TX
 ///   confirmation, both stamped with the end-of-frame bus time;
-/// - error confinement per port (bus/fault_confinement.hpp): TEC/REC on success, ACK errors and
+/// - error confinement per port (the rules of bus/physics/): TEC/REC on success, ACK errors and
 ///   retransmission for a port alone on the bus (it stops at error-passive), bus-off, recovery
 ///   after 1408 bit times or on command;
 /// - the fault stage (Faults) sits between arbitration and delivery.
@@ -74,7 +74,7 @@ class Broker {
   /// Bus-off recovery on command (like `ip link set can0 type can restart`): the port becomes
   /// error-active now with TEC = REC = 0 (error-passive with TEC 128 while
   /// FaultStage::HoldErrorPassive holds it). Ends a FaultStage::ForceBusOff hold. False when it is
-  /// not bus-off or unknown.
+  /// not bus-off or unknown, and while FaultStage::HoldBusOff holds it (the attempt fails).
   bool RecoverBusOff(PortId port);
 
   /// The fault stage of a bus. Throws std::invalid_argument on an unknown bus.

@@ -1,52 +1,48 @@
 #include "orchestrator/broker/fault_stage.hpp"
 
-#include "orchestrator/broker/virtual_bus.hpp"
-
-#include <algorithm>
-#include <cmath>
-#include <stdexcept>
 #include <utility>
+
+#include "orchestrator/broker/fault_rules.hpp"
+#include "orchestrator/broker/virtual_bus.hpp"
 
 namespace canfleet::broker {
 
-namespace {
-
-/// splitmix64: tiny, fast and identical on every platform (std::uniform_*_distribution is not), so
-/// a seed gives the same faults everywhere.
-std::uint64_t NextRandom(std::uint64_t& state) {
-  state += 0x9E3779B97F4A7C15ULL;
-  std::uint64_t z = state;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
-
-BusTime ToBusTime(TimePoint t) {
-  return t.time_since_epoch();
-}
-
-}  // namespace
-
-const char* ToString(FaultAction action) {
+const char* ToString(RuleAction action) {
   switch (action) {
-    case FaultAction::kDrop:
+    case RuleAction::kDrop:
       return "drop";
-    case FaultAction::kDelay:
+    case RuleAction::kDelay:
       return "delay";
-    case FaultAction::kCorrupt:
+    case RuleAction::kCorrupt:
       return "corrupt";
-    case FaultAction::kDuplicate:
+    case RuleAction::kDuplicate:
       return "duplicate";
   }
   return "?";
 }
 
-FaultStage::FaultStage(Scheduler& scheduler, detail::VirtualBus& bus) : scheduler_(scheduler), bus_(bus) {
-  fired_.reserve(16);
+RuleId FaultStage::Add(FaultRule rule) {
+  return rules_.Add(std::move(rule), scheduler_.Now().time_since_epoch());
+}
+
+bool FaultStage::Remove(RuleId id) {
+  return rules_.Remove(id);
+}
+
+void FaultStage::Clear() {
+  rules_.Clear();
+}
+
+std::vector<RuleStatus> FaultStage::List() const {
+  return rules_.List(scheduler_.Now().time_since_epoch());
 }
 
 bool FaultStage::ForceBusOff(PortId port, bool hold) {
   return bus_.ForceBusOff(bus_.PortOnBus(port), hold);
+}
+
+bool FaultStage::HoldBusOff(PortId port, bool on) {
+  return bus_.HoldBusOff(bus_.PortOnBus(port), on);
 }
 
 bool FaultStage::HoldErrorPassive(PortId port, bool on) {
@@ -59,135 +55,6 @@ bool FaultStage::StartBabbling(PortId port, const CanFrame& frame) {
 
 bool FaultStage::StopBabbling(PortId port) {
   return bus_.StopBabbling(bus_.PortOnBus(port));
-}
-
-RuleId FaultStage::Add(FaultRule rule) {
-  if (!(rule.probability >= 0.0 && rule.probability <= 1.0))  // also rejects NaN
-    throw std::invalid_argument("fault rule: probability must be within 0..1");
-  if (rule.delay < Duration::zero() || rule.jitter < Duration::zero())
-    throw std::invalid_argument("fault rule: delay and jitter must not be negative");
-  if (rule.lifetime && *rule.lifetime <= Duration::zero())
-    throw std::invalid_argument("fault rule: lifetime must be positive");
-  if (rule.count && *rule.count == 0) throw std::invalid_argument("fault rule: count must be at least 1");
-
-  Rule r;
-  r.id = next_id_++;
-  r.added = ToBusTime(scheduler_.Now());
-  if (rule.lifetime) r.expires = r.added + *rule.lifetime;
-  r.remaining = rule.count;
-  r.rng = rule.seed;
-  r.spec = std::move(rule);
-  rules_.push_back(std::move(r));
-  return rules_.back().id;
-}
-
-bool FaultStage::Remove(RuleId id) {
-  auto it = std::find_if(rules_.begin(), rules_.end(), [id](const Rule& r) { return r.id == id; });
-  if (it == rules_.end()) return false;
-  rules_.erase(it);
-  return true;
-}
-
-void FaultStage::Clear() {
-  rules_.clear();
-}
-
-std::vector<RuleStatus> FaultStage::List() const {
-  const BusTime now = ToBusTime(scheduler_.Now());
-  std::vector<RuleStatus> out;
-  for (const Rule& r : rules_) {
-    if (r.expires && *r.expires <= now) continue;
-    RuleStatus s;
-    s.id = r.id;
-    s.rule = r.spec;
-    s.hits = r.hits;
-    s.remaining = r.remaining;
-    if (r.expires) s.expires = TimePoint(*r.expires);
-    out.push_back(std::move(s));
-  }
-  return out;
-}
-
-bool FaultStage::Matches(const Rule& rule, PortId source, const CanFrame& frame, BusTime start) {
-  if (start < rule.added) return false;
-  if (rule.expires && start >= *rule.expires) return false;
-  if (rule.remaining && *rule.remaining == 0) return false;
-  const FaultRule& s = rule.spec;
-  if (s.source && *s.source != source) return false;
-  if (s.extended && *s.extended != frame.extended()) return false;
-  return ((frame.id ^ s.id) & s.mask) == 0;
-}
-
-bool FaultStage::Fires(Rule& rule) {
-  const double p = rule.spec.probability;
-  bool fires = p >= 1.0;
-  if (!fires && p > 0.0) {
-    // 53 random bits → [0, 1) with full double precision.
-    const double u = static_cast<double>(NextRandom(rule.rng) >> 11) * 0x1.0p-53;
-    fires = u < p;
-  }
-  if (!fires) return false;
-  ++rule.hits;
-  if (rule.remaining) --*rule.remaining;
-  return true;
-}
-
-void FaultStage::Sweep(BusTime now) {
-  std::erase_if(rules_, [now](const Rule& r) {
-    return (r.remaining && *r.remaining == 0) || (r.expires && *r.expires <= now);
-  });
-}
-
-bool FaultStage::CorruptAttempt(PortId source, const CanFrame& frame, BusTime start) {
-  bool corrupt = false;
-  for (Rule& r : rules_) {
-    if (r.spec.action != FaultAction::kCorrupt || !Matches(r, source, frame, start)) continue;
-    if (Fires(r)) {
-      corrupt = true;
-      break;
-    }
-  }
-  Sweep(start);
-  return corrupt;
-}
-
-bool FaultStage::EvaluateDelivery(PortId source, const CanFrame& frame, BusTime start, bool repetition) {
-  fired_.clear();
-  bool duplicate = false;
-  for (std::size_t i = 0; i < rules_.size(); ++i) {
-    Rule& r = rules_[i];
-    const FaultAction action = r.spec.action;
-    if (action == FaultAction::kCorrupt) continue;
-    if (action == FaultAction::kDuplicate && (repetition || duplicate)) continue;
-    if (!Matches(r, source, frame, start) || !Fires(r)) continue;
-    if (action == FaultAction::kDuplicate)
-      duplicate = true;
-    else
-      fired_.push_back(i);
-  }
-  return duplicate;
-}
-
-FaultStage::Decision FaultStage::ForReceiver(PortId receiver) {
-  for (std::size_t i : fired_) {
-    Rule& r = rules_[i];
-    const auto& receivers = r.spec.receivers;
-    if (!receivers.empty() && std::find(receivers.begin(), receivers.end(), receiver) == receivers.end())
-      continue;
-    if (r.spec.action == FaultAction::kDrop) return {Decision::kDrop, {}};
-    Duration delay = r.spec.delay;
-    if (r.spec.jitter > Duration::zero()) {
-      const auto span = static_cast<std::uint64_t>(r.spec.jitter.count()) + 1;
-      delay += Duration(static_cast<Duration::rep>(NextRandom(r.rng) % span));
-    }
-    return {Decision::kDelay, delay};
-  }
-  return {};
-}
-
-void FaultStage::EndOfTransfer(BusTime start) {
-  fired_.clear();
-  Sweep(start);
 }
 
 }  // namespace canfleet::broker

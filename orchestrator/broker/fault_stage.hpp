@@ -1,8 +1,12 @@
 #pragma once
-/// @file The fault stage of one bus: rules applied between arbitration and delivery, plus direct
-/// controller faults. The fault looks to every node as it would on a real bus (design decision 3):
-/// a dropped heartbeat is simply never seen; a corrupted frame is an error frame on the wire with
-/// its error-counter consequences.
+/// @file The fault stage of one bus, its public face: rules applied between arbitration and
+/// delivery, plus direct controller faults. The fault looks to every node as it would on a real bus
+/// (design decision 3): a dropped heartbeat is simply never seen; a corrupted frame is an error
+/// frame on the wire with its error-counter consequences.
+///
+/// Who does what: the rules decide (fault_rules.hpp: which transfer is corrupted, which receiver
+/// misses or gets a frame late, knowing nothing of the bus); the bus acts on those decisions and
+/// performs the controller faults (virtual_bus.hpp). This class only forwards to them.
 
 #include <chrono>
 #include <cstdint>
@@ -18,9 +22,12 @@ namespace canfleet::broker {
 
 namespace detail {
 class VirtualBus;
-}
+class FaultRules;
+}  // namespace detail
 
-enum class FaultAction : std::uint8_t {
+/// What a FaultRule does to a transfer it fires on. (Not telemetry::FaultAction, which says
+/// whether a fault of the fleet began or ended.)
+enum class RuleAction : std::uint8_t {
   /// The matched receivers never see the frame. The transfer itself succeeded on the wire: the
   /// sender gets its TX confirmation and every receiver's REC still decreases.
   kDrop,
@@ -43,7 +50,7 @@ enum class FaultAction : std::uint8_t {
   kDuplicate,
 };
 
-const char* ToString(FaultAction action);
+const char* ToString(RuleAction action);
 
 /// One rule. A rule applies to a transfer whose start of frame lies within its lifetime (from the
 /// scheduler time at which it was added), sent by `source`, whose identifier matches `id` under
@@ -55,7 +62,7 @@ struct FaultRule {
   std::optional<bool> extended{};   ///< only 29-bit (true) or 11-bit (false) frames; nullopt = both
   std::vector<PortId> receivers{};  ///< kDrop/kDelay: the receivers affected; empty = every receiver
 
-  FaultAction action = FaultAction::kDrop;
+  RuleAction action = RuleAction::kDrop;
   Duration delay{};   ///< kDelay: fixed part
   Duration jitter{};  ///< kDelay: random extra in [0, jitter], drawn per receiver
 
@@ -85,9 +92,9 @@ struct RuleStatus {
 /// reach back to transfers that started before it was added.
 class FaultStage {
  public:
-  /// `bus` performs the direct controller faults (ForceBusOff, HoldErrorPassive, StartBabbling) on its
-  /// ports; the bus owns its stage.
-  FaultStage(Scheduler& scheduler, detail::VirtualBus& bus);
+  /// The bus owns its stage, its rules and its ports.
+  FaultStage(const Scheduler& scheduler, detail::FaultRules& rules, detail::VirtualBus& bus)
+      : scheduler_(scheduler), rules_(rules), bus_(bus) {}
 
   /// Adds a rule; returns its id (never reused on this bus). Throws std::invalid_argument when the
   /// probability is not within 0..1, a duration is negative, the lifetime is not positive or the
@@ -111,6 +118,16 @@ class FaultStage {
   /// nothing to do: already bus-off, and (with `hold`) already held. Holding a port that is
   /// already bus-off cancels its pending automatic recovery.
   bool ForceBusOff(PortId port, bool hold = false);
+
+  /// A cause that keeps the port bus-off, as a shorted transceiver or a wiring fault at the node
+  /// would (`on`), or its end. On: the port goes bus-off now (TEC 256, queue dropped) unless it
+  /// already is, and while the cause lasts every recovery attempt fails: the automatic attempts
+  /// (1408 bit times after the bus-off, then every 1408 bit times, on a bus that recovers by
+  /// itself) are counted in PortStats::failed_recoveries and leave it bus-off, and
+  /// Broker::RecoverBusOff returns false (also counted). Its state and TEC stay visible in
+  /// PortStats throughout. Off: the cause is gone and the next attempt succeeds (the next automatic
+  /// one, or RecoverBusOff). Returns false when the cause already was in that state.
+  bool HoldBusOff(PortId port, bool on);
 
   /// Holds the port's controller error-passive (`on`) or releases it; see
   /// FaultConfinement::HoldErrorPassive for the counters: on = TEC ≥ 128 from now on, the port is
@@ -136,46 +153,9 @@ class FaultStage {
   bool StopBabbling(PortId port);
 
  private:
-  friend class detail::VirtualBus;
-
-  struct Rule {
-    RuleId id = 0;
-    FaultRule spec;
-    BusTime added{};
-    std::optional<BusTime> expires;
-    std::optional<std::uint64_t> remaining;
-    std::uint64_t hits = 0;
-    std::uint64_t rng = 0;  ///< splitmix64 state
-  };
-
-  /// What one receiver gets.
-  struct Decision {
-    enum Kind : std::uint8_t { kDeliver, kDrop, kDelay } kind = kDeliver;
-    Duration delay{};
-  };
-
-  // ---- the broker's side, all on the bus time line ----
-  bool Empty() const { return rules_.empty(); }
-  /// At start of frame: true when a corrupt rule fires on this transfer attempt.
-  bool CorruptAttempt(PortId source, const CanFrame& frame, BusTime start);
-  /// At end of an acknowledged transfer: evaluates drop/delay/duplicate rules once. Returns true
-  /// when the transfer is to be repeated (kDuplicate). `repetition` marks a repeated transfer.
-  bool EvaluateDelivery(PortId source, const CanFrame& frame, BusTime start, bool repetition);
-  /// After EvaluateDelivery: what `receiver` gets.
-  Decision ForReceiver(PortId receiver);
-  /// After the receivers were served: forgets the fired set, removes rules that are used up or
-  /// expired at `start` (starts of frame only move forward on a bus).
-  void EndOfTransfer(BusTime start);
-
-  static bool Matches(const Rule& rule, PortId source, const CanFrame& frame, BusTime start);
-  static bool Fires(Rule& rule);
-  void Sweep(BusTime now);
-
-  Scheduler& scheduler_;
+  const Scheduler& scheduler_;
+  detail::FaultRules& rules_;
   detail::VirtualBus& bus_;
-  std::vector<Rule> rules_;
-  std::vector<std::size_t> fired_;  ///< indexes into rules_ of drop/delay rules fired on this transfer
-  RuleId next_id_ = 1;
 };
 
 }  // namespace canfleet::broker

@@ -62,6 +62,8 @@ struct PortStats {
   std::uint64_t fault_drops = 0;    ///< deliveries to this port suppressed by drop rules
   /// Frames sent by FaultStage::StartBabbling (not in tx_frames: the node did not send them).
   std::uint64_t babble_frames = 0;
+  /// Bus-off recovery attempts that failed because FaultStage::HoldBusOff held the port.
+  std::uint64_t failed_recoveries = 0;
 };
 
 }  // namespace canfleet::broker

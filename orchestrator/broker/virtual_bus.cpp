@@ -10,8 +10,6 @@ namespace canfleet::broker::detail {
 
 namespace {
 
-constexpr std::uint32_t kMinBitrate = 10'000;
-constexpr std::uint32_t kMaxBitrate = 1'000'000;
 /// The shortest transfer: base format, DLC 0, no stuff bit (34 + tail 10 + intermission 3).
 constexpr double kShortestTransferBits = 47;
 
@@ -74,7 +72,7 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
     : scheduler_(scheduler),
       config_(Validated(std::move(config))),
       created_(Now()),
-      faults_(scheduler, *this),
+      faults_(scheduler, rules_, *this),
       timer_(scheduler, [this] { OnTimer(); }),
       free_at_(created_),
       log_(LogCapacity(config_)) {
@@ -157,6 +155,10 @@ std::size_t VirtualBus::Submit(Port& port, std::span<const CanFrame> frames) {
 bool VirtualBus::RecoverBusOff(Port& port) {
   return WithRound([&] {
     if (port.detached || port.controller.State() != ControllerState::kBusOff) return false;
+    if (port.bus_off_cause) {
+      ++port.failed_recoveries;  // the cause persists: the attempt fails
+      return false;
+    }
     Recover(port);
     return true;
   });
@@ -179,6 +181,20 @@ bool VirtualBus::ForceBusOff(Port& port, bool hold) {
     Disturb();
     Emit(port, port.controller.ForceBusOff());
     EnterBusOff(port, Now());
+    return true;
+  });
+}
+
+bool VirtualBus::HoldBusOff(Port& port, bool on) {
+  return WithRound([&] {
+    if (port.detached || port.bus_off_cause == on) return false;
+    port.bus_off_cause = on;
+    // Released: the pending automatic attempt (if any) succeeds when it falls due.
+    if (on && port.controller.State() != ControllerState::kBusOff) {
+      Disturb();
+      Emit(port, port.controller.ForceBusOff());
+      EnterBusOff(port, Now());
+    }
     return true;
   });
 }
@@ -328,17 +344,15 @@ Port* VirtualBus::Arbitrate(BusTime start) const {
 }
 
 bool VirtualBus::HasAcknowledger(const Port& transmitter, BusTime start) const {
-  // Any other controller that is not bus-off acknowledges a valid frame, error-passive ones too
-  // (ISO 11898-1:2015 §6.10); a listen-only port never drives the bus.
   for (const auto& p : ports_) {
-    if (p.get() == &transmitter || p->detached || p->options.listen_only || !AttachedBy(*p, start)) continue;
-    if (p->controller.State() != ControllerState::kBusOff) return true;
+    if (p.get() == &transmitter || p->detached || !AttachedBy(*p, start)) continue;
+    if (Acknowledges(p->controller.State(), p->options.listen_only)) return true;
   }
   return false;
 }
 
 TransferOutcome VirtualBus::Outcome(Port& transmitter, const CanFrame& frame, BusTime start) {
-  if (!faults_.Empty() && faults_.CorruptAttempt(transmitter.id, frame, start))
+  if (!rules_.Empty() && rules_.CorruptAttempt(transmitter.id, frame, start))
     return TransferOutcome::kCrcError;
   if (!HasAcknowledger(transmitter, start)) return TransferOutcome::kAckError;
   return TransferOutcome::kOk;
@@ -387,7 +401,7 @@ void VirtualBus::Process(BusTime now, bool start_at_now) {
         break;
       }
       case Kind::kRecover:
-        Recover(*recovering);
+        AttemptRecovery(*recovering);
         break;
       case Kind::kDelayed: {
         std::pop_heap(delayed_.begin(), delayed_.end(), DueLater);
@@ -420,117 +434,131 @@ void VirtualBus::Process(BusTime now, bool start_at_now) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// A transfer ends
+
 void VirtualBus::Complete(const InFlight& transfer) {
-  Port& tx = *transfer.port;
-  const CanFrame& frame = transfer.entry.frame;
   if (config_.paced) free_at_ = transfer.end;
   const bool ok = transfer.outcome == TransferOutcome::kOk;
-  log_.Record(transfer.start, transfer.end, frame, !ok);
-  // The transmitter may have been detached or forced bus-off while its frame was on the wire:
-  // the frame still completes for the receivers, but the transmitter's side is gone.
-  const bool tx_live =
-      !tx.detached && tx.queue_epoch == transfer.epoch && tx.controller.State() != ControllerState::kBusOff;
-  auto receives = [&](const Port& p) {
-    return !p.detached && AttachedBy(p, transfer.start) && p.controller.State() != ControllerState::kBusOff;
-  };
+  log_.Record(transfer.start, transfer.end, transfer.entry.frame, !ok);
+  if (ok)
+    Delivered(transfer);
+  else
+    Failed(transfer);
+}
 
-  if (ok) {
-    ++frames_;
-    const bool faults = !faults_.Empty();
-    const bool repeat =
-        faults && faults_.EvaluateDelivery(tx.id, frame, transfer.start, transfer.entry.repetition);
-    const TimedFrame timed{frame, transfer.end};
-    // Written once for every receiver (the shared round); a port that does not receive it skips
-    // it. The sender never receives its own frame.
-    const std::uint32_t index = ShareFrame(timed);
-    tx.exceptions.push_back(index);
-    std::uint64_t delivered = 0;
-    if (!faults && ReceiversAtRest(tx, transfer.start))
-      delivered = ports_.size() - 1;  // every other port, nothing to count: no loop
-    else
-      for (std::size_t i = 0; i < ports_.size(); ++i) {
-        Port& rx = *ports_[i];
-        if (&rx == &tx) continue;
-        if (!receives(rx)) {
-          rx.exceptions.push_back(index);
-          continue;
-        }
-        const FaultStage::Decision decision = faults ? faults_.ForReceiver(rx.id) : FaultStage::Decision{};
-        switch (decision.kind) {
-          case FaultStage::Decision::kDeliver:
-            ++delivered;  // rx_frames: counted when the port is flushed
-            break;
-          case FaultStage::Decision::kDrop:
-            rx.exceptions.push_back(index);
-            ++rx.fault_drops;
-            ++fault_drops_;
-            break;
-          case FaultStage::Decision::kDelay:
-            rx.exceptions.push_back(index);
-            delayed_.push_back({transfer.end + decision.delay, delay_seq_++, rx.id, frame});
-            std::push_heap(delayed_.begin(), delayed_.end(), DueLater);
-            ++fault_delays_;
-            break;
-        }
-        // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8). Usually nothing to
-        // count (error-active, REC 0): tested first. (With every receiver so, and no fault rule,
-        // this loop does not run at all: ReceiversAtRest.)
-        if (!rx.options.listen_only && !rx.controller.ReceiveSuccessChangesNothing()) {
-          Emit(rx, rx.controller.OnReceiveSuccess());
-          Disturb();  // REC changed
-        }
-      }
-    deliveries_ += delivered;
-    if (faults) faults_.EndOfTransfer(transfer.start);
-    if (tx_live && transfer.entry.babble) {
-      // Not the node's frame: no confirmation, nothing leaves its queue.
-      ++tx.babble_frames;
-      tx.babble.repetition = repeat;
-      Emit(tx, tx.controller.OnTransmitSuccess());
-      SuspendIfPassive(tx, transfer.end);
-    } else if (tx_live) {
-      ++tx.tx_frames;
-      if (!transfer.entry.repetition) tx.tx.push_back(timed);
-      if (repeat)
-        tx.queue.front().repetition = true;  // stays at the head: sent once more
-      else
-        tx.queue.pop_front();
-      // Successful transmission: TEC − 1 (rule 7).
-      Emit(tx, tx.controller.OnTransmitSuccess());
-      SuspendIfPassive(tx, transfer.end);
+void VirtualBus::Delivered(const InFlight& transfer) {
+  Port& tx = *transfer.port;
+  ++frames_;
+  const bool faults = !rules_.Empty();
+  const bool repeat = faults && rules_.EvaluateDelivery(tx.id, transfer.entry.frame, transfer.start,
+                                                        transfer.entry.repetition);
+  const TimedFrame timed{transfer.entry.frame, transfer.end};
+  // Written once for every receiver (the shared round); a port that does not receive it skips
+  // it. The sender never receives its own frame.
+  const std::uint32_t index = ShareFrame(timed);
+  tx.exceptions.push_back(index);
+  if (!faults && ReceiversAtRest(tx, transfer.start))
+    deliveries_ += ports_.size() - 1;  // every other port, nothing to count: no loop
+  else
+    deliveries_ += DeliverToEach(transfer, index, faults);
+  if (faults) rules_.EndOfTransfer(transfer.start);
+  if (TransmitterLive(transfer)) Confirm(transfer, timed, repeat);
+}
+
+std::uint64_t VirtualBus::DeliverToEach(const InFlight& transfer, std::uint32_t index, bool faults) {
+  const Port& tx = *transfer.port;
+  std::uint64_t delivered = 0;
+  for (std::size_t i = 0; i < ports_.size(); ++i) {
+    Port& rx = *ports_[i];
+    if (&rx == &tx) continue;
+    if (!Receives(rx, transfer.start)) {
+      rx.exceptions.push_back(index);
+      continue;
     }
-    return;
+    const FaultRules::Decision decision = faults ? rules_.ForReceiver(rx.id) : FaultRules::Decision{};
+    switch (decision.kind) {
+      case FaultRules::Decision::kDeliver:
+        ++delivered;  // rx_frames: counted when the port is flushed
+        break;
+      case FaultRules::Decision::kDrop:
+        rx.exceptions.push_back(index);
+        ++rx.fault_drops;
+        ++fault_drops_;
+        break;
+      case FaultRules::Decision::kDelay:
+        rx.exceptions.push_back(index);
+        delayed_.push_back({transfer.end + decision.delay, delay_seq_++, rx.id, transfer.entry.frame});
+        std::push_heap(delayed_.begin(), delayed_.end(), DueLater);
+        ++fault_delays_;
+        break;
+    }
+    // Receiving a valid frame: REC − 1 (ISO 11898-1:2015 §12.1.4, rule 8). Usually nothing to
+    // count (error-active, REC 0): tested first. (With every receiver so, and no fault rule,
+    // this loop does not run at all: ReceiversAtRest.)
+    if (!rx.options.listen_only && !rx.controller.ReceiveSuccessChangesNothing()) {
+      Emit(rx, rx.controller.OnReceiveSuccess());
+      Disturb();  // REC changed
+    }
   }
+  return delivered;
+}
 
+void VirtualBus::Confirm(const InFlight& transfer, const TimedFrame& timed, bool repeat) {
+  Port& tx = *transfer.port;
+  if (transfer.entry.babble) {
+    // Not the node's frame: no confirmation, nothing leaves its queue.
+    ++tx.babble_frames;
+    tx.babble.repetition = repeat;
+  } else {
+    ++tx.tx_frames;
+    if (!transfer.entry.repetition) tx.tx.push_back(timed);
+    if (repeat)
+      tx.queue.front().repetition = true;  // stays at the head: sent once more
+    else
+      tx.queue.pop_front();
+  }
+  // Successful transmission: TEC − 1 (rule 7).
+  Emit(tx, tx.controller.OnTransmitSuccess());
+  SuspendIfPassive(tx, transfer.end);
+}
+
+void VirtualBus::Failed(const InFlight& transfer) {
   ++error_frames_;
   Disturb();  // counters change below
   CanFrame error_frame;
-  error_frame.id = frame.id;
-  error_frame.flags = static_cast<std::uint8_t>(CanFrame::kError | (frame.flags & CanFrame::kExtended));
+  error_frame.id = transfer.entry.frame.id;
+  error_frame.flags =
+      static_cast<std::uint8_t>(CanFrame::kError | (transfer.entry.frame.flags & CanFrame::kExtended));
   for (std::size_t i = 0; i < ports_.size(); ++i) {
     Port& p = *ports_[i];
-    if (p.options.error_frames && receives(p)) AddPrivateFrame(p, {error_frame, transfer.end});
+    if (p.options.error_frames && Receives(p, transfer.start))
+      AddPrivateFrame(p, {error_frame, transfer.end});
   }
-  if (tx_live) {
-    // Transmit error: TEC + 8 (rule 3), except an ACK error of an error-passive transmitter
-    // (rule 3, exception 1): a lone node stops at error-passive. The frame stays queued and is
-    // retransmitted automatically (ISO 11898-1:2015 §6.11).
-    ++tx.tx_errors;
-    Emit(tx, tx.controller.OnTransmitError(
-                 transfer.outcome == TransferOutcome::kAckError ? TransmitError::kAck : TransmitError::kBit));
-    if (tx.controller.State() == ControllerState::kBusOff)
-      EnterBusOff(tx, transfer.end);
-    else
-      SuspendIfPassive(tx, transfer.end);
-  }
-  if (transfer.outcome == TransferOutcome::kCrcError) {
-    // Every receiver detects the error: REC + 1 (rule 1).
-    for (std::size_t i = 0; i < ports_.size(); ++i) {
-      Port& rx = *ports_[i];
-      if (&rx == &tx || rx.options.listen_only || !receives(rx)) continue;
-      ++rx.rx_errors;
-      Emit(rx, rx.controller.OnReceiveError());
-    }
+  if (TransmitterLive(transfer)) CountTransmitError(transfer);
+  if (transfer.outcome == TransferOutcome::kCrcError) CountReceiveErrors(transfer);
+}
+
+void VirtualBus::CountTransmitError(const InFlight& transfer) {
+  // Transmit error: TEC + 8 (rule 3), except an ACK error of an error-passive transmitter
+  // (rule 3, exception 1): a lone node stops at error-passive. The frame stays queued and is
+  // retransmitted automatically (ISO 11898-1:2015 §6.11).
+  Port& tx = *transfer.port;
+  ++tx.tx_errors;
+  Emit(tx, tx.controller.OnTransmitError(TransmitErrorOf(transfer.outcome)));
+  if (tx.controller.State() == ControllerState::kBusOff)
+    EnterBusOff(tx, transfer.end);
+  else
+    SuspendIfPassive(tx, transfer.end);
+}
+
+void VirtualBus::CountReceiveErrors(const InFlight& transfer) {
+  // Every receiver detects the error: REC + 1 (rule 1).
+  for (std::size_t i = 0; i < ports_.size(); ++i) {
+    Port& rx = *ports_[i];
+    if (&rx == transfer.port || rx.options.listen_only || !Receives(rx, transfer.start)) continue;
+    ++rx.rx_errors;
+    Emit(rx, rx.controller.OnReceiveError());
   }
 }
 
@@ -540,6 +568,17 @@ void VirtualBus::DeliverDelayed(const Delayed& delayed) {
   AddPrivateFrame(*rx, {delayed.frame, delayed.due});
   ++rx->rx_frames;
   ++deliveries_;
+}
+
+void VirtualBus::AttemptRecovery(Port& port) {
+  if (port.bus_off_cause) {
+    // The cause persists: the controller does not see its 128 × 11 recessive bits, stays bus-off
+    // and starts counting again.
+    ++port.failed_recoveries;
+    port.recover_at = RecoveryAttemptAt(*port.recover_at, config_.bitrate);
+    return;
+  }
+  Recover(port);
 }
 
 void VirtualBus::Recover(Port& port) {
@@ -563,17 +602,15 @@ void VirtualBus::EnterBusOff(Port& port, BusTime at) {
   port.queue.clear();
   ++port.queue_epoch;
   port.ready_at = BusTime{};
-  // Recovery after 128 occurrences of 11 consecutive recessive bits (ISO 11898-1:2015 §12.1.4.2),
-  // counted as 1408 bit times from the end of the error frame that caused the bus-off.
   if (config_.auto_recover && !port.hold_bus_off && !port.recover_at) {
-    port.recover_at = at + BitTime(kBusOffRecoveryBits, config_.bitrate);
+    port.recover_at = RecoveryAttemptAt(at, config_.bitrate);
     ++pending_recoveries_;
   }
 }
 
 void VirtualBus::SuspendIfPassive(Port& port, BusTime end) {
   if (config_.paced && port.controller.State() == ControllerState::kErrorPassive)
-    port.ready_at = end + BitTime(kSuspendTransmissionBits, config_.bitrate);
+    port.ready_at = ReadyAfterTransfer(ControllerState::kErrorPassive, end, config_.bitrate);
 }
 
 void VirtualBus::Emit(Port& port, const std::optional<ControllerEvent>& event) {
@@ -773,6 +810,7 @@ PortStats VirtualBus::StatsOf(const Port& port) const {
   s.bus_off_drops = port.bus_off_drops;
   s.fault_drops = port.fault_drops;
   s.babble_frames = port.babble_frames;
+  s.failed_recoveries = port.failed_recoveries;
   return s;
 }
 

@@ -17,9 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "bus/fault_confinement.hpp"
+#include "bus/physics/fault_confinement.hpp"
+#include "bus/physics/wire_model.hpp"
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/bus_config.hpp"
+#include "orchestrator/broker/fault_rules.hpp"
 #include "orchestrator/broker/fault_stage.hpp"
 #include "orchestrator/broker/outbox.hpp"
 #include "orchestrator/broker/port_sink.hpp"
@@ -27,7 +29,6 @@
 #include "orchestrator/broker/submission_order.hpp"
 #include "orchestrator/broker/transmission_log.hpp"
 #include "orchestrator/broker/tx_queue.hpp"
-#include "orchestrator/broker/wire_model.hpp"
 
 namespace canfleet::broker::detail {
 
@@ -54,6 +55,7 @@ struct Port {
   BusTime ready_at{};                 ///< suspend transmission: may not start a transfer before
   std::optional<BusTime> recover_at;  ///< automatic bus-off recovery due
   bool hold_bus_off = false;          ///< bus-off until RecoverBusOff (FaultStage::ForceBusOff hold)
+  bool bus_off_cause = false;         ///< every recovery attempt fails (FaultStage::HoldBusOff)
   bool ack_blocked = false;           ///< unpaced: head got an ACK error, wait for another port
   /// Babbling idiot (FaultStage::StartBabbling): this entry is offered ahead of the queue.
   bool babbling = false;
@@ -78,6 +80,7 @@ struct Port {
   std::uint64_t tx_frames = 0, rx_frames = 0, tx_errors = 0, rx_errors = 0;
   std::uint64_t queue_drops = 0, invalid_drops = 0, bus_off_drops = 0, fault_drops = 0;
   std::uint64_t babble_frames = 0;
+  std::uint64_t failed_recoveries = 0;
 };
 
 class VirtualBus {
@@ -95,6 +98,7 @@ class VirtualBus {
   bool RecoverBusOff(Port& port);
   // Direct controller faults (FaultStage's public face documents them).
   bool ForceBusOff(Port& port, bool hold);
+  bool HoldBusOff(Port& port, bool on);
   bool HoldErrorPassive(Port& port, bool on);
   bool StartBabbling(Port& port, const CanFrame& frame);
   bool StopBabbling(Port& port);
@@ -158,9 +162,37 @@ class VirtualBus {
     return !config_.paced || port.attached_at <= start;
   }
   bool HasAcknowledger(const Port& transmitter, BusTime start) const;
+  /// Whether `port` takes part in a transfer that started at `start` as a receiver.
+  bool Receives(const Port& port, BusTime start) const {
+    return !port.detached && AttachedBy(port, start) && port.controller.State() != ControllerState::kBusOff;
+  }
+  /// The transmitter may have been detached or forced bus-off while its frame was on the wire: the
+  /// frame still completes for the receivers, but the transmitter's side is gone.
+  static bool TransmitterLive(const InFlight& transfer) {
+    const Port& tx = *transfer.port;
+    return !tx.detached && tx.queue_epoch == transfer.epoch &&
+           tx.controller.State() != ControllerState::kBusOff;
+  }
   TransferOutcome Outcome(Port& transmitter, const CanFrame& frame, BusTime start);
+
+  // ---- A transfer ends: one function per outcome, the wire's rules from bus/physics/ ----
   void Complete(const InFlight& transfer);
+  /// Acknowledged: shared with every receiver, each as the fault rules decide; TX confirmation.
+  void Delivered(const InFlight& transfer);
+  /// Serves each receiver by the fault rules' decision for it and counts its REC; returns how many
+  /// got the frame now.
+  std::uint64_t DeliverToEach(const InFlight& transfer, std::uint32_t index, bool faults);
+  /// The transmitter's side of an acknowledged transfer: its own frame leaves the queue (or stays
+  /// for a repetition), a babble frame does not; TEC − 1.
+  void Confirm(const InFlight& transfer, const TimedFrame& timed, bool repeat);
+  /// Failed (ACK or CRC error): error frames to the ports that want them, the counters' rules.
+  void Failed(const InFlight& transfer);
+  void CountTransmitError(const InFlight& transfer);
+  void CountReceiveErrors(const InFlight& transfer);
+
   void DeliverDelayed(const Delayed& delayed);
+  /// An automatic recovery attempt falls due: it fails while a cause holds the port bus-off.
+  void AttemptRecovery(Port& port);
   void Recover(Port& port);
   void EnterBusOff(Port& port, BusTime at);
   void SuspendIfPassive(Port& port, BusTime end);
@@ -185,7 +217,7 @@ class VirtualBus {
   void ResetRound();
   /// Whether a frame sent by `tx` that started at `start` needs no work per receiver: no port
   /// other than `tx` is detached, bus-off, counting REC down or (paced) attached after `start`.
-  /// Then every other port receives it and nothing else changes (the fast path of Complete).
+  /// Then every other port receives it and nothing else changes (the fast path of Delivered).
   bool ReceiversAtRest(const Port& tx, BusTime start);
   /// Something ReceiversAtRest depends on may have changed.
   void Disturb() { rest_.valid = false; }
@@ -199,7 +231,8 @@ class VirtualBus {
   Scheduler& scheduler_;
   BusConfig config_;
   BusTime created_;
-  FaultStage faults_;
+  FaultRules rules_;   ///< decides
+  FaultStage faults_;  ///< the public face of rules_ and of the controller faults
   Timer timer_;
 
   std::vector<std::unique_ptr<Port>> ports_;

@@ -1,6 +1,5 @@
 #include "orchestrator/control/fault_text.hpp"
 
-#include <array>
 #include <cctype>
 #include <sstream>
 
@@ -9,27 +8,6 @@
 namespace canfleet::control {
 
 namespace {
-
-struct KindName {
-  FaultKind kind;
-  std::string_view name;
-};
-
-constexpr std::array<KindName, 13> kKinds{{
-    {BUS_OFF, "bus-off"},
-    {HEARTBEAT_LOSS, "heartbeat-loss"},
-    {RPDO_TIMEOUT, "rpdo-timeout"},
-    {DROP, "drop"},
-    {DELAY, "delay"},
-    {CORRUPT, "corrupt"},
-    {DUPLICATE, "duplicate"},
-    {PARTITION, "partition"},
-    {BABBLING_IDIOT, "babbling-idiot"},
-    {ERROR_PASSIVE, "error-passive"},
-    {KILL, "kill"},
-    {RESTART, "restart"},
-    {POWER_CYCLE, "power-cycle"},
-}};
 
 std::string Join(const google::protobuf::RepeatedPtrField<std::string>& names) {
   std::string out;
@@ -103,14 +81,13 @@ std::string Normalised(std::string_view name) {
 }  // namespace
 
 std::string_view FaultKindName(FaultKind kind) {
-  for (const KindName& k : kKinds)
-    if (k.kind == kind) return k.name;
-  return "unspecified";
+  const FaultKindTraits* traits = TraitsOf(kind);
+  return traits != nullptr ? traits->name : "unspecified";
 }
 
 std::optional<FaultKind> ParseFaultKind(std::string_view name) {
   const std::string n = Normalised(name);
-  for (const KindName& k : kKinds)
+  for (const FaultKindTraits& k : FaultKinds())
     if (k.name == n) return k.kind;
   return std::nullopt;
 }
@@ -118,7 +95,7 @@ std::optional<FaultKind> ParseFaultKind(std::string_view name) {
 const std::vector<std::string>& FaultKindNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
-    for (const KindName& k : kKinds)
+    for (const FaultKindTraits& k : FaultKinds())
       v.emplace_back(k.name);
     return v;
   }();
@@ -134,6 +111,10 @@ std::string SummarizeFault(const FaultSpec& spec) {
   const std::string node = spec.node().empty() ? "?" : spec.node();
   switch (spec.kind()) {
     case BUS_OFF:
+      if (spec.duration_ms() != 0)
+        return kind + " of " + node + OnBus(spec) + ", held for " +
+               FormatDuration(std::chrono::milliseconds(spec.duration_ms())) +
+               " (every recovery attempt fails until then)";
       return kind + " of " + node + OnBus(spec) +
              (spec.manual_recovery() ? ", manual recovery (until cleared)"
                                      : ", recovering after 128 x 11 recessive bits");

@@ -1,7 +1,7 @@
 #pragma once
-/// @file Faults as people read and type them: the CLI's kind names ("heartbeat-loss") and a
-/// one-line summary of a FaultSpec, shared by the CLI, the fleet manager (FaultInjected.summary,
-/// FaultStatus.summary) and the topology loader's messages.
+/// @file Faults as people read and type them: the CLI's kind names ("heartbeat-loss", from the
+/// table of fault kinds, fault_kinds.hpp) and a one-line summary of a FaultSpec, shared by the CLI,
+/// the fleet manager (FaultInjected.summary, FaultStatus.summary) and the topology loader's messages.
 
 #include <optional>
 #include <string>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "orchestrator/control/canfleet_control.pb.h"
+#include "orchestrator/control/fault_kinds.hpp"
 
 namespace canfleet::control {
 
@@ -30,6 +31,7 @@ const std::vector<std::string>& FaultKindNames();
 ///   "drop of frames 0x185 from quad-5 on can0 (to quad-6), probability 0.5 (seed 7), for 10s"
 ///   "delay of all frames from any node on can1 by 10ms + 0..5ms, for 100 frames"
 ///   "partition of can0 into [quad-5, quad-6] and [quad-7], until cleared"
+///   "bus-off of quad-5 on can0, held for 2s (every recovery attempt fails until then)"
 ///   "restart of quad-5"
 std::string SummarizeFault(const FaultSpec& spec);
 

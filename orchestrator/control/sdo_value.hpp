@@ -3,6 +3,10 @@
 /// ASCII gateway): b i8 i16 i32 i64 u8 u16 u32 u64 r32 r64 vs os d. The control API's SdoRead and
 /// SdoWrite, the topology's `sdo` writes and the CLI share these rules.
 ///
+/// The types are CiA 301 data types (canopen::DataType, one enum for the whole tree) and the values
+/// go through the one value codec, in its gateway syntax (node/canopen/od/value_text.hpp); this
+/// adds cocomm's names, the trimming and the messages, which name type and text.
+///
 /// Encoding (CiA 301 §7.1: every basic type little-endian):
 ///   b        "true"/"false" or "1"/"0"                        -> 1 byte, 01h/00h
 ///   i8..i64  decimal or 0x hex, optional sign, range-checked  -> 1, 2, 4, 8 bytes, two's complement
@@ -25,29 +29,38 @@
 #include <string_view>
 #include <vector>
 
+#include "node/canopen/od/types.hpp"
+
 namespace canfleet::control {
 
-enum class SdoType : std::uint8_t {
-  kHex,  ///< no type given: raw bytes as hex
-  kBoolean,
-  kInteger8,
-  kInteger16,
-  kInteger32,
-  kInteger64,
-  kUnsigned8,
-  kUnsigned16,
-  kUnsigned32,
-  kUnsigned64,
-  kReal32,
-  kReal64,
-  kVisibleString,
-  kOctetString,
-  kDomain,
+/// A type as cocomm names it: a CiA 301 data type ("u16" is UNSIGNED16), or no type at all (""),
+/// which reads and shows raw bytes as hex. SdoType::kUnsigned16 is canopen::DataType::kUnsigned16.
+class SdoType {
+ public:
+  using enum canopen::DataType;
+
+  /// No type: raw bytes as hex.
+  constexpr SdoType() = default;
+  /// A data type is an SDO type.
+  constexpr SdoType(canopen::DataType type) : type_(type) {}  // NOLINT(google-explicit-constructor)
+
+  /// The CiA 301 type; nullopt for raw bytes.
+  constexpr std::optional<canopen::DataType> data_type() const { return type_; }
+
+  friend constexpr bool operator==(const SdoType&, const SdoType&) = default;
+
+  /// No type given: raw bytes as hex.
+  static const SdoType kHex;
+
+ private:
+  std::optional<canopen::DataType> type_;
 };
+
+inline constexpr SdoType SdoType::kHex{};
 
 /// The type named `name` ("u16"; "" is kHex), or nullopt for an unknown name.
 std::optional<SdoType> ParseSdoType(std::string_view name);
-/// The cocomm name of `type` ("u16"; "" for kHex).
+/// The cocomm name of `type` ("u16"; "" for kHex and for data types cocomm has no name for).
 std::string_view SdoTypeName(SdoType type);
 /// Every type name, for help and error texts: "b i8 i16 i32 i64 u8 u16 u32 u64 r32 r64 vs os d".
 std::string_view SdoTypeNames();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "orchestrator/control/fault_kinds.hpp"
 #include "orchestrator/control/fault_text.hpp"
 
 namespace canfleet::fleet {
@@ -21,7 +22,8 @@ struct FaultManager::Fault {
   std::vector<broker::RuleId> rules;   ///< on `bus`
   std::optional<broker::PortId> port;  ///< controller faults, babbling idiot
   std::uint64_t ended_hits = 0;        ///< hits of rules already removed
-  std::uint64_t babble_base = 0;       ///< the port's babble_frames when the fault began
+  /// The port's babble_frames (babbling idiot) or failed_recoveries (held bus-off) when it began.
+  std::uint64_t port_base = 0;
   std::unique_ptr<Timer> expiry;
 };
 
@@ -93,11 +95,18 @@ control::FaultInjected FaultManager::Inject(const control::FaultSpec& spec) {
       if (Active(f->state) && f->spec.label() == spec.label())
         throw FaultError("a fault labelled '" + spec.label() + "' is already active");
   }
-  if (spec.probability() < 0 || spec.probability() > 1) throw FaultError("probability must be within 0..1");
   auto fault = std::make_unique<Fault>();
   fault->id = next_id_;
   fault->spec = spec;
   fault->started = ctx_.scheduler.Now();
+  // What the kind takes and needs (one table for the CLI, the topology and here), once the bus
+  // the fault acts on is known: the node's first bus, or the fleet's only bus.
+  const control::FaultKindTraits* kind = control::TraitsOf(spec.kind());
+  if (kind != nullptr && kind->takes.Has(control::FaultOption::kBus) && spec.bus().empty() &&
+      (!spec.node().empty() || ctx_.broker.Buses().size() == 1))
+    fault->spec.set_bus(BusFor(spec));
+  if (const auto problem = control::CheckFaultSpec(fault->spec, control::FaultSpelling::kCli))
+    throw FaultError(problem->reason);
   Apply(*fault);  // throws before anything is registered
   if (fault->spec.bus().empty() && !fault->bus.empty()) fault->spec.set_bus(fault->bus);
   fault->summary = control::SummarizeFault(fault->spec);
@@ -106,9 +115,7 @@ control::FaultInjected FaultManager::Inject(const control::FaultSpec& spec) {
 
   // A bus-off with automatic recovery is over once the controller has recovered (1408 bit
   // times): an event, like a restart, not a state to clear.
-  const bool one_shot = spec.kind() == control::RESTART || spec.kind() == control::POWER_CYCLE ||
-                        (spec.kind() == control::BUS_OFF && !spec.manual_recovery());
-  if (one_shot) {
+  if (control::IsOneShot(spec)) {
     added.state = "done";
     added.ended = added.started;
   } else if (spec.duration_ms() > 0) {
@@ -164,6 +171,13 @@ void FaultManager::ApplyBusOff(Fault& fault) {
   fault.bus = BusFor(fault.spec);
   fault.port = PortOf(fault.bus, Node(fault.spec.node()).name());
   auto& stage = ctx_.broker.Faults(fault.bus);
+  if (fault.spec.duration_ms() > 0) {
+    // Held: a cause that persists, so every recovery attempt fails until the fault ends.
+    fault.port_base = ctx_.broker.Port(*fault.port).failed_recoveries;
+    if (!stage.HoldBusOff(*fault.port, true))
+      throw FaultError("node '" + fault.spec.node() + "' is already held bus-off");
+    return;
+  }
   if (!stage.ForceBusOff(*fault.port, fault.spec.manual_recovery()))
     throw FaultError("node '" + fault.spec.node() + "' is already bus-off");
 }
@@ -178,20 +192,22 @@ void FaultManager::ApplyHeartbeatLoss(Fault& fault) {
   rule.mask = kStandardMask;
   rule.extended = false;
   rule.receivers = ReceiverPorts(fault.bus, fault.spec);
-  rule.action = broker::FaultAction::kDrop;
+  rule.action = broker::RuleAction::kDrop;
+  rule.probability = fault.spec.probability() > 0 ? fault.spec.probability() : 1.0;
+  rule.seed = fault.spec.seed();
+  if (fault.spec.count() > 0) rule.count = fault.spec.count();
   fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
 }
 
 void FaultManager::ApplyRpdoTimeout(Fault& fault) {
   const FleetNode& node = Node(fault.spec.node());
-  if (!fault.spec.has_cob_id()) throw FaultError("rpdo-timeout needs the PDO's COB-ID (--cob-id)");
   fault.bus = BusFor(fault.spec);
   broker::FaultRule rule;
   rule.id = fault.spec.cob_id();
   rule.mask = fault.spec.extended() ? kExtendedMask : kStandardMask;
   rule.extended = fault.spec.extended();
   rule.receivers = {PortOf(fault.bus, node.name())};
-  rule.action = broker::FaultAction::kDrop;
+  rule.action = broker::RuleAction::kDrop;
   fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
 }
 
@@ -204,24 +220,24 @@ void FaultManager::ApplyFrameFault(Fault& fault) {
     rule.id = spec.cob_id();
     rule.mask = spec.has_mask() ? spec.mask() : (spec.extended() ? kExtendedMask : kStandardMask);
     rule.extended = spec.extended();
+  } else if (spec.extended()) {
+    rule.extended = true;  // "all extended frames"
   }
   rule.receivers = ReceiverPorts(fault.bus, spec);
   switch (spec.kind()) {
     case control::DROP:
-      rule.action = broker::FaultAction::kDrop;
+      rule.action = broker::RuleAction::kDrop;
       break;
     case control::DELAY:
-      rule.action = broker::FaultAction::kDelay;
+      rule.action = broker::RuleAction::kDelay;
       rule.delay = std::chrono::milliseconds(spec.delay_ms());
       rule.jitter = std::chrono::milliseconds(spec.jitter_ms());
-      if (spec.delay_ms() == 0 && spec.jitter_ms() == 0)
-        throw FaultError("delay needs --delay and/or --jitter");
       break;
     case control::CORRUPT:
-      rule.action = broker::FaultAction::kCorrupt;
+      rule.action = broker::RuleAction::kCorrupt;
       break;
     default:
-      rule.action = broker::FaultAction::kDuplicate;
+      rule.action = broker::RuleAction::kDuplicate;
       break;
   }
   rule.probability = spec.probability() > 0 ? spec.probability() : 1.0;
@@ -236,7 +252,6 @@ void FaultManager::ApplyFrameFault(Fault& fault) {
 
 void FaultManager::ApplyPartition(Fault& fault) {
   const auto& spec = fault.spec;
-  if (spec.groups_size() < 2) throw FaultError("partition needs at least two groups (--group a,b --group c)");
   fault.bus = BusFor(spec);
   // Resolve everything first, so a bad name leaves no half-applied partition.
   std::vector<std::vector<broker::PortId>> groups;
@@ -257,7 +272,7 @@ void FaultManager::ApplyPartition(Fault& fault) {
       broker::FaultRule rule;
       rule.source = port;
       rule.receivers = others;
-      rule.action = broker::FaultAction::kDrop;
+      rule.action = broker::RuleAction::kDrop;
       fault.rules.push_back(stage.Add(rule));
     }
   }
@@ -275,7 +290,7 @@ void FaultManager::ApplyBabblingIdiot(Fault& fault) {
   // the node's queue, at the bus's full rate, as by a babbling controller.
   try {
     ctx_.broker.Faults(fault.bus).StartBabbling(*fault.port, frame);
-    fault.babble_base = ctx_.broker.Port(*fault.port).babble_frames;
+    fault.port_base = ctx_.broker.Port(*fault.port).babble_frames;
   } catch (const std::invalid_argument& e) {
     throw FaultError(std::string("babbling-idiot: ") + e.what());
   }
@@ -326,9 +341,11 @@ std::size_t FaultManager::Clear(const control::FaultClear& which) {
 std::uint64_t FaultManager::Hits(const Fault& fault) const {
   std::uint64_t hits = fault.ended_hits;
   if (!Active(fault.state)) return hits;
-  if (fault.spec.kind() == control::BABBLING_IDIOT && fault.port) {
+  const bool held_bus_off = fault.spec.kind() == control::BUS_OFF && fault.spec.duration_ms() > 0;
+  if ((fault.spec.kind() == control::BABBLING_IDIOT || held_bus_off) && fault.port) {
     try {
-      hits += ctx_.broker.Port(*fault.port).babble_frames - fault.babble_base;
+      const broker::PortStats port = ctx_.broker.Port(*fault.port);
+      hits += (held_bus_off ? port.failed_recoveries : port.babble_frames) - fault.port_base;
     } catch (const std::invalid_argument&) {
       // detached: its count went with it
     }
@@ -366,8 +383,14 @@ void FaultManager::End(Fault& fault, const char* state) {
   try {
     switch (fault.spec.kind()) {
       case control::BUS_OFF:
-        // Recovery on command; an automatically recovered port is not bus-off any more.
-        if (fault.port) ctx_.broker.RecoverBusOff(*fault.port);
+        if (!fault.port) break;
+        if (fault.spec.duration_ms() > 0)
+          // The cause is gone: the next recovery attempt succeeds (on a bus that recovers on
+          // command only, the port then waits for one, as after any bus-off).
+          stage.HoldBusOff(*fault.port, false);
+        else
+          // Recovery on command; an automatically recovered port is not bus-off any more.
+          ctx_.broker.RecoverBusOff(*fault.port);
         break;
       case control::ERROR_PASSIVE:
         if (fault.port) stage.HoldErrorPassive(*fault.port, false);

@@ -4,7 +4,7 @@
 
 #include <asio/post.hpp>
 
-#include "bus/capture/capture_tap.hpp"
+#include "orchestrator/capture/capture_tap.hpp"
 #include "orchestrator/fleet/configuration_plan.hpp"
 
 namespace canfleet::fleet {
@@ -59,7 +59,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
       server_(server),
       options_(std::move(options)),
       origin_(scheduler.Now()),
-      wall_origin_(capture::WallClockOrigin(scheduler)),
+      wall_origin_(options_.wall_origin.value_or(WallClockOrigin(scheduler))),
       supervisor_(io, scheduler,
                   Supervisor::Hooks{
                       .started =
@@ -73,7 +73,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
                           },
                       .ended = {},
                   }),
-      captures_(broker, capture::WallClockOrigin(scheduler)) {
+      captures_(broker, wall_origin_) {
   for (const auto& spec : options_.topology.node()) {
     FleetNode node;
     node.spec = spec;
@@ -95,10 +95,12 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
   tracker_.OnBootUp([this](const std::string& bus, std::uint8_t id) { OnBootUp(bus, id); });
   tracker_.OnEmcy([this](const std::string& bus, std::uint8_t id, const SeenEmcy& emcy) {
     const FleetNode* node = NodeAt(bus, id);
-    spdlog::info("{}: EMCY {:04X}h, error register {:02X}h, data {:02X} {:02X} {:02X} {:02X} {:02X}",
+    // A node with several CAN ports has an EMCY producer on each: say which one sent it.
+    const std::string port = node && node->buses.size() > 1 ? " (" + bus + ")" : "";
+    spdlog::info("{}: EMCY {:04X}h, error register {:02X}h, data {:02X} {:02X} {:02X} {:02X} {:02X}{}",
                  node ? node->name() : bus + "#" + std::to_string(id), emcy.code, emcy.error_register,
                  emcy.manufacturer[0], emcy.manufacturer[1], emcy.manufacturer[2], emcy.manufacturer[3],
-                 emcy.manufacturer[4]);
+                 emcy.manufacturer[4], port);
   });
 
   faults_ = std::make_unique<FaultManager>(FaultManager::Context{

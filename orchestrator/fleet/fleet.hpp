@@ -10,11 +10,13 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bus/capture/capture_writer.hpp"
 #include "clock/scheduler.hpp"
+#include "clock/wall_clock.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/control/control_handler.hpp"
 #include "orchestrator/fleet/external_adoption.hpp"
@@ -38,6 +40,9 @@ struct FleetOptions {
   /// Added to every node's command line: the DDS options `canfleet up` was given
   /// (telemetry::DdsArguments), so its nodes publish where it does.
   std::vector<std::string> node_arguments;
+  /// Wall-clock time of scheduler time 0 for dumps and captures: the process's one origin
+  /// (host::BrokerHost::wall_origin), which socketcand uses too. Unset: read when the fleet starts.
+  std::optional<WallTime> wall_origin;
 };
 
 class Fleet final : public control::ControlHandler {
@@ -99,7 +104,7 @@ class Fleet final : public control::ControlHandler {
   transport::BrokerServer& server_;
   FleetOptions options_;
   TimePoint origin_;
-  capture::WallTime wall_origin_;
+  WallTime wall_origin_;
 
   std::vector<FleetNode> nodes_;
   std::map<std::string, std::unique_ptr<MasterPort>> masters_;          ///< by bus

@@ -173,31 +173,46 @@ control::Status Fleet::Status() const {
       attached = attached && ports.count({bus, node.name()}) != 0;
     out->set_attached(attached);
 
-    const std::string& bus = node.buses.front();
-    if (auto it = ports.find({bus, node.name()}); it != ports.end()) {
-      const auto& c = it->second.controller;
-      out->set_controller(c.state == ControllerState::kBusOff         ? "bus-off"
-                          : c.state == ControllerState::kErrorPassive ? "error-passive"
-                                                                      : "error-active");
-      out->set_tec(c.tec);
-      out->set_rec(c.rec);
+    // Each port as the master sees it on its bus; the node's own fields repeat port 1's.
+    for (std::size_t p = 0; p < node.buses.size(); ++p) {
+      const std::string& bus = node.buses[p];
+      auto* port = out->add_ports();
+      port->set_bus(bus);
+      port->set_node_id(node.node_ids[p]);
+      if (auto it = ports.find({bus, node.name()}); it != ports.end()) {
+        const auto& c = it->second.controller;
+        port->set_controller(c.state == ControllerState::kBusOff         ? "bus-off"
+                             : c.state == ControllerState::kErrorPassive ? "error-passive"
+                                                                         : "error-active");
+        port->set_tec(c.tec);
+        port->set_rec(c.rec);
+      }
+      const NodeLiveState* live = tracker_.Find(bus, node.node_ids[p]);
+      port->set_booted(live && live->booted);
+      port->set_nmt_state(NmtStateName(live ? live->nmt_state : std::nullopt));
+      port->set_heartbeat_age_s(
+          live && live->last_heartbeat
+              ? std::chrono::duration<double>(scheduler_.Now() - *live->last_heartbeat).count()
+              : -1.0);
+      if (live && live->last_emcy) {
+        auto* emcy = port->mutable_last_emcy();
+        emcy->set_code(live->last_emcy->code);
+        emcy->set_register_(live->last_emcy->error_register);
+        emcy->set_manufacturer(
+            std::string(live->last_emcy->manufacturer.begin(), live->last_emcy->manufacturer.end()));
+        emcy->set_time_s(std::chrono::duration<double>(live->last_emcy->time - origin_).count());
+        port->set_emcy_count(live->emcy_count);
+      }
     }
-    const NodeLiveState* live = tracker_.Find(bus, node.node_ids.front());
-    out->set_booted(live && live->booted);
-    out->set_nmt_state(NmtStateName(live ? live->nmt_state : std::nullopt));
-    out->set_heartbeat_age_s(
-        live && live->last_heartbeat
-            ? std::chrono::duration<double>(scheduler_.Now() - *live->last_heartbeat).count()
-            : -1.0);
-    if (live && live->last_emcy) {
-      auto* emcy = out->mutable_last_emcy();
-      emcy->set_code(live->last_emcy->code);
-      emcy->set_register_(live->last_emcy->error_register);
-      emcy->set_manufacturer(
-          std::string(live->last_emcy->manufacturer.begin(), live->last_emcy->manufacturer.end()));
-      emcy->set_time_s(std::chrono::duration<double>(live->last_emcy->time - origin_).count());
-      out->set_emcy_count(live->emcy_count);
-    }
+    const control::PortStatus& first = out->ports(0);
+    out->set_controller(first.controller());
+    out->set_tec(first.tec());
+    out->set_rec(first.rec());
+    out->set_booted(first.booted());
+    out->set_nmt_state(first.nmt_state());
+    out->set_heartbeat_age_s(first.heartbeat_age_s());
+    if (first.has_last_emcy()) *out->mutable_last_emcy() = first.last_emcy();
+    out->set_emcy_count(first.emcy_count());
     if (out->detail().empty()) {
       auto rt = runtime_.find({node.name(), 0});
       if (rt != runtime_.end()) out->set_detail(rt->second.configuration);

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "bus/capture/capture_tap.hpp"
 #include "bus/capture/capture_writer.hpp"
 #include "orchestrator/broker/broker.hpp"
+#include "orchestrator/capture/capture_tap.hpp"
 #include "orchestrator/control/control_handler.hpp"
 
 namespace canfleet::fleet {

@@ -1,27 +1,21 @@
-// `canfleet up`: wires the orchestrator's parts on one event loop and runs it.
+// `canfleet up`: the broker's host (host::BrokerHost, as canfleet-broker has it) plus the fleet and
+// the control API, on one event loop.
 #include "orchestrator/fleet/run_fleet.hpp"
 
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
-#include <asio/steady_timer.hpp>
 #include <fstream>
 #include <iostream>
 
 #include "bus/wire/tcp_endpoint_text.hpp"
-#include "clock/asio_scheduler.hpp"
-#include "orchestrator/broker/broker.hpp"
-#include "orchestrator/broker_telemetry/broker_telemetry.hpp"
 #include "orchestrator/control/control_server.hpp"
 #include "orchestrator/control/fault_text.hpp"
 #include "orchestrator/fleet/fleet.hpp"
-#include "orchestrator/socketcand/server.hpp"
+#include "orchestrator/host/broker_host.hpp"
 #include "orchestrator/topology/topology_loader.hpp"
-#include "orchestrator/transport/broker_server.hpp"
 #include "telemetry/cli_options.hpp"
-#include "telemetry/orchestrator_telemetry.hpp"
 
 namespace canfleet::fleet {
 
@@ -84,32 +78,24 @@ int RunFleet(const UpOptions& options) {
 
   spdlog::set_level(spdlog::level::from_str(options.log_level));
   asio::io_context io(1);
-  AsioScheduler scheduler(io);
-  broker::Broker broker(scheduler);
-  transport::BrokerServer server(io, broker);
   socketcand::ServerOptions socketcand_options;
   socketcand_options.bind_address = options.socketcand_bind;
-  socketcand::Server socketcand(io, broker, scheduler, socketcand_options);
+  host::BrokerHost host(io, socketcand_options);
   std::unique_ptr<Fleet> fleet;
   std::unique_ptr<control::ControlServer> control_server;
   std::string control_endpoint, broker_endpoint;
   try {
     for (const auto& bus : spec.bus()) {
-      broker::BusConfig config;
-      config.name = bus.name();
-      config.bitrate = bus.bitrate();
-      config.paced = !bus.unpaced();
-      config.auto_recover = !bus.manual_recovery();
-      broker.AddBus(config);
-      spdlog::info("bus {}: {} bit/s, {}", config.name, config.bitrate, config.paced ? "paced" : "unpaced");
-      if (bus.socketcand_port() != 0) {
-        const auto port = socketcand.Serve(bus.name(), static_cast<std::uint16_t>(bus.socketcand_port()));
-        spdlog::info("bus {}: socketcand on port {}", bus.name(), port);
-      }
+      host.AddBus({.name = bus.name(),
+                   .bitrate = bus.bitrate(),
+                   .paced = !bus.unpaced(),
+                   .auto_recover = !bus.manual_recovery()});
+      if (bus.socketcand_port() != 0)
+        host.ServeSocketcand(bus.name(), static_cast<std::uint16_t>(bus.socketcand_port()));
     }
     for (const auto& listen : spec.orchestrator().listen())
-      server.Listen(wire::Endpoint::Parse(listen));
-    broker_endpoint = server.Endpoints().front().ToString();
+      host.Listen(wire::Endpoint::Parse(listen));
+    broker_endpoint = host.Endpoints().front().ToString();
 
     FleetOptions fleet_options;
     fleet_options.topology = spec;
@@ -117,7 +103,9 @@ int RunFleet(const UpOptions& options) {
     fleet_options.start_processes = !options.no_start;
     if (!options.no_start) fleet_options.node_binary = FindNodeBinary(options.node_binary);
     fleet_options.node_arguments = telemetry::DdsArguments(options.dds);
-    fleet = std::make_unique<Fleet>(io, scheduler, broker, server, std::move(fleet_options));
+    fleet_options.wall_origin = host.wall_origin();
+    fleet =
+        std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
     control_server = std::make_unique<control::ControlServer>(io, *fleet);
     const auto bound = control_server->Listen(spec.orchestrator().control());
     control_endpoint = "tcp://" + wire::TcpEndpointText(bound);
@@ -127,26 +115,12 @@ int RunFleet(const UpOptions& options) {
   }
   spdlog::info("control API on {}, nodes connect to {}", control_endpoint, broker_endpoint);
 
-  // Telemetry: the buses' statistics and the fault event log on DDS (the nodes publish their own).
-  // Declared after the broker and destroyed before it; the fleet runs without it if DDS fails.
-  std::optional<telemetry::Participant> participant;
-  std::optional<telemetry::OrchestratorTelemetry> publisher;
-  std::optional<broker::BrokerTelemetry> bus_telemetry;
-  if (options.telemetry) {
-    try {
-      participant.emplace(options.dds);
-      publisher.emplace(*participant);
-      bus_telemetry.emplace(broker, scheduler, *publisher);
-      spdlog::info("telemetry: BusStats and FaultEvents on DDS domain {}", options.dds.domain_id);
-    } catch (const std::exception& e) {
-      spdlog::error("telemetry: {}; running without it", e.what());
-      bus_telemetry.reset();
-      publisher.reset();
-      participant.reset();
-    }
-  }
+  // Telemetry: the buses' statistics and the fault event log on DDS (the nodes publish their own);
+  // the fleet runs without it if DDS fails.
+  if (options.telemetry) host.StartTelemetry(options.dds, std::chrono::seconds(1));
   fleet->OnFaultEvent([&](const control::FaultStatus& status, bool started) {
-    if (!bus_telemetry) return;
+    broker::BrokerTelemetry* bus_telemetry = host.telemetry();
+    if (bus_telemetry == nullptr) return;
     try {
       if (started) {
         broker::FaultReport report;
@@ -165,7 +139,6 @@ int RunFleet(const UpOptions& options) {
   WriteStateFile(options.ready_file, control_endpoint, broker_endpoint, "starting");
 
   bool stopping = false;
-  asio::steady_timer drain(io);
   auto shutdown = [&](const char* why) {
     if (stopping) return;
     stopping = true;
@@ -173,24 +146,16 @@ int RunFleet(const UpOptions& options) {
     fleet->Stop([&] {
       spdlog::info("every node process has stopped");
       control_server->Close();
-      socketcand.Stop();
-      server.Close();
-      // Let the farewells leave before the loop ends.
-      drain.expires_after(std::chrono::milliseconds(200));
-      drain.async_wait([&](const asio::error_code&) { io.stop(); });
+      host.Stop();
     });
   };
   fleet->OnReady([&] { WriteStateFile(options.ready_file, control_endpoint, broker_endpoint, "ready"); });
   fleet->OnShutdownRequest([&] { shutdown("canfleet down"); });
-  asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const asio::error_code& ec, int signal) {
-    if (!ec) shutdown(signal == SIGINT ? "SIGINT" : "SIGTERM");
-  });
+  host.OnSignal(shutdown);
   fleet->Start();
   io.run();
   control_server.reset();
   fleet.reset();
-  bus_telemetry.reset();
   spdlog::info("stopped");
   return 0;
 }

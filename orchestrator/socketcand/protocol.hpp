@@ -23,6 +23,7 @@
 #include <string_view>
 
 #include "bus/can_frame.hpp"
+#include "clock/wall_clock.hpp"
 
 namespace canfleet::socketcand {
 
@@ -36,8 +37,9 @@ inline constexpr std::size_t kMaxBusNameLength = 16;
 /// Frame messages are padded to this size in aligned mode (see AppendFrame).
 inline constexpr std::size_t kAlignedRecordSize = 64;
 
-/// Wall-clock time (Unix epoch) of a frame, as socketcand prints its kernel timestamps.
-using WallTime = std::chrono::sys_time<std::chrono::nanoseconds>;
+/// Wall-clock time (Unix epoch) of a frame, as socketcand prints its kernel timestamps
+/// (clock/wall_clock.hpp).
+using canfleet::WallTime;
 
 /// Splits what a client sends into elements, like socketcand's receive_command: bytes before a
 /// '<' are garbage and dropped, an element runs from '<' to the next '>' (a second '<' before it

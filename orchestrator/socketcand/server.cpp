@@ -6,7 +6,6 @@
 #include <asio/error.hpp>
 #include <asio/ip/address.hpp>
 #include <asio/ip/tcp.hpp>
-#include <asio/steady_timer.hpp>
 #include <stdexcept>
 
 #include "orchestrator/socketcand/session.hpp"
@@ -14,14 +13,23 @@
 namespace canfleet::socketcand {
 namespace detail {
 
+/// Creates, registers and starts the session of a connected client.
+void StartSession(const std::shared_ptr<Context>& ctx, asio::generic::stream_protocol::socket socket,
+                  std::string_view bus, std::string peer);
+
 struct Listener : std::enable_shared_from_this<Listener> {
   Listener(std::shared_ptr<Context> c, std::string b)
-      : ctx(std::move(c)), bus(std::move(b)), acceptor(ctx->io), retry(ctx->io) {}
+      : ctx(std::move(c)), bus(std::move(b)), acceptor(ctx->io) {
+    retry.emplace(ctx->scheduler, [this] {
+      if (!ctx->stopped) Accept();
+    });
+  }
 
   void Accept();
   void OnAccept(const asio::error_code& ec, asio::ip::tcp::socket socket);
+  /// Also destroys the retry timer: a pending accept may keep the listener beyond the scheduler.
   void Close() {
-    retry.cancel();
+    retry.reset();
     asio::error_code ec;
     acceptor.close(ec);
   }
@@ -29,7 +37,7 @@ struct Listener : std::enable_shared_from_this<Listener> {
   std::shared_ptr<Context> ctx;
   std::string bus;
   asio::ip::tcp::acceptor acceptor;
-  asio::steady_timer retry;  ///< after a failed accept (out of file descriptors...)
+  std::optional<Timer> retry;  ///< after a failed accept (out of file descriptors...)
 };
 
 void Listener::Accept() {
@@ -44,34 +52,36 @@ void Listener::OnAccept(const asio::error_code& ec, asio::ip::tcp::socket socket
   if (ec) {
     // Typically EMFILE: retry later instead of spinning on a listener that keeps failing.
     spdlog::warn("socketcand {}: accept failed: {}; retrying in 100 ms", bus, ec.message());
-    retry.expires_after(std::chrono::milliseconds(100));
-    retry.async_wait([self = shared_from_this()](const asio::error_code& timer_ec) {
-      if (!timer_ec && !self->ctx->stopped) self->Accept();
-    });
+    if (retry) retry->StartAfter(std::chrono::milliseconds(100));
     return;
   }
+  asio::error_code peer_ec;
+  const auto peer = socket.remote_endpoint(peer_ec);
+  socket.set_option(asio::ip::tcp::no_delay(true), peer_ec);  // as socketcand: one frame, one segment
+  StartSession(
+      ctx, asio::generic::stream_protocol::socket(std::move(socket)), bus,
+      peer_ec ? std::string("unknown peer") : peer.address().to_string() + ":" + std::to_string(peer.port()));
+  Accept();
+}
+
+void StartSession(const std::shared_ptr<Context>& ctx, asio::generic::stream_protocol::socket socket,
+                  std::string_view bus, std::string peer) {
   auto& sessions = ctx->sessions;
   sessions.erase(std::remove_if(sessions.begin(), sessions.end(), [](const auto& s) { return s->closed(); }),
                  sessions.end());
-  auto session = std::make_shared<Session>(ctx, std::move(socket), bus);
+  auto session = std::make_shared<Session>(ctx, std::move(socket), bus, std::move(peer));
   sessions.push_back(session);
   ++ctx->stats.sessions_accepted;
   ++ctx->stats.sessions_open;
   session->Start();
-  Accept();
 }
 
 }  // namespace detail
 
-Server::Server(asio::io_context& io, broker::Broker& broker, const Scheduler& scheduler,
-               ServerOptions options)
-    : context_(std::make_shared<detail::Context>(io, broker, std::move(options))) {
-  if (context_->options.wall_origin) {
-    context_->origin = *context_->options.wall_origin;
-  } else {
-    const auto now = std::chrono::time_point_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now());
-    context_->origin = now - scheduler.Now().time_since_epoch();
-  }
+Server::Server(asio::io_context& io, broker::Broker& broker, Scheduler& scheduler, ServerOptions options)
+    : context_(std::make_shared<detail::Context>(io, broker, scheduler, std::move(options))) {
+  // The process's one wall-clock origin when given (host::BrokerHost gives it), else read now.
+  context_->origin = context_->options.wall_origin.value_or(WallClockOrigin(scheduler));
 }
 
 Server::~Server() {
@@ -79,11 +89,7 @@ Server::~Server() {
 }
 
 std::uint16_t Server::Serve(std::string_view bus, std::optional<std::uint16_t> port) {
-  const auto buses = context_->broker.Buses();
-  if (std::find(buses.begin(), buses.end(), bus) == buses.end())
-    throw std::invalid_argument("socketcand: unknown bus " + std::string(bus));
-  if (context_->Serves(bus))
-    throw std::invalid_argument("socketcand: bus " + std::string(bus) + " is already served");
+  CheckServable(bus);
   const std::uint16_t wanted = port.value_or(static_cast<std::uint16_t>(kDefaultPort + listeners_.size()));
 
   auto listener = std::make_shared<detail::Listener>(context_, std::string(bus));
@@ -100,6 +106,26 @@ std::uint16_t Server::Serve(std::string_view bus, std::optional<std::uint16_t> p
   listener->Accept();
   spdlog::info("socketcand: serving {} on {}:{}", bus, context_->options.bind_address, bound);
   return bound;
+}
+
+void Server::CheckServable(std::string_view bus) const {
+  const auto buses = context_->broker.Buses();
+  if (std::find(buses.begin(), buses.end(), bus) == buses.end())
+    throw std::invalid_argument("socketcand: unknown bus " + std::string(bus));
+  if (context_->Serves(bus))
+    throw std::invalid_argument("socketcand: bus " + std::string(bus) + " is already served");
+}
+
+void Server::Offer(std::string_view bus) {
+  CheckServable(bus);
+  context_->stopped = false;
+  context_->buses.emplace_back(bus);
+}
+
+void Server::Adopt(asio::generic::stream_protocol::socket socket, std::string_view bus, std::string peer) {
+  if (!context_->Serves(bus))
+    throw std::invalid_argument("socketcand: bus " + std::string(bus) + " is not served");
+  detail::StartSession(context_, std::move(socket), bus, std::move(peer));
 }
 
 void Server::Stop() {

@@ -9,8 +9,11 @@
 /// See protocol.hpp for the protocol and session.hpp for a session's rules.
 ///
 /// Threading: everything runs on the thread of the io_context, which must also drive the
-/// broker's Scheduler (an AsioScheduler on the same io_context).
+/// broker's Scheduler (an AsioScheduler on the same io_context, or a SimulatedScheduler the same
+/// thread advances: unit tests). Every timer of the endpoint (raw-mode settle, drain timeout,
+/// accept retry) is a Timer on that scheduler.
 
+#include <asio/generic/stream_protocol.hpp>
 #include <asio/io_context.hpp>
 #include <chrono>
 #include <cstddef>
@@ -50,7 +53,8 @@ struct ServerOptions {
   /// this long: a port alone on a bus never gets its frames acknowledged.
   Duration drain_timeout = std::chrono::seconds(2);
   /// Wall-clock time of bus time 0, for the frames' timestamps. Default: read from the system
-  /// clock when the server is created (capture::WallClockOrigin does the same).
+  /// clock when the server is created (WallClockOrigin, clock/wall_clock.hpp). A process that also
+  /// captures gives its one origin here (host::BrokerHost does), so both stamp a frame alike.
   std::optional<WallTime> wall_origin;
 };
 
@@ -72,11 +76,11 @@ struct Listener;
 
 class Server {
  public:
-  /// `broker` must outlive the server and run on `io` (its scheduler an AsioScheduler on `io`).
-  /// `scheduler` is the broker's: its time 0 is mapped to the wall clock for the frames'
-  /// timestamps (unless ServerOptions::wall_origin says otherwise).
-  Server(asio::io_context& io, broker::Broker& broker, const Scheduler& scheduler,
-         ServerOptions options = {});
+  /// `broker` must outlive the server and run on `io` (its scheduler an AsioScheduler on `io`, or
+  /// a SimulatedScheduler advanced by the thread that runs `io`). `scheduler` is the broker's: the
+  /// endpoint's timers run on it, and its time 0 is mapped to the wall clock for the frames'
+  /// timestamps (unless ServerOptions::wall_origin says otherwise). It must outlive the server.
+  Server(asio::io_context& io, broker::Broker& broker, Scheduler& scheduler, ServerOptions options = {});
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
@@ -89,12 +93,24 @@ class Server {
   /// std::system_error when the address cannot be bound.
   std::uint16_t Serve(std::string_view bus, std::optional<std::uint16_t> port = std::nullopt);
 
+  /// Lets clients open `bus` without a listener of its own: clients of Adopt(), or of another
+  /// bus's listener. Throws std::invalid_argument as Serve() does.
+  void Offer(std::string_view bus);
+
+  /// Serves a client connected by other means than a listener (one end of a socketpair in unit
+  /// tests, an inherited descriptor) as if it had connected to `bus`'s port. `peer` names it in
+  /// log lines. Throws std::invalid_argument for a bus this server does not serve.
+  void Adopt(asio::generic::stream_protocol::socket socket, std::string_view bus, std::string peer);
+
   /// Closes the listeners and every session (their ports are detached). Idempotent.
   void Stop();
 
   ServerStats Stats() const;
 
  private:
+  /// Throws std::invalid_argument for a bus the broker does not have or that is already served.
+  void CheckServable(std::string_view bus) const;
+
   std::shared_ptr<detail::Context> context_;
   std::vector<std::shared_ptr<detail::Listener>> listeners_;
 };

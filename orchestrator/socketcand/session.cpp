@@ -37,16 +37,16 @@ bool Context::Serves(std::string_view bus) const {
   return std::find(buses.begin(), buses.end(), bus) != buses.end();
 }
 
-Session::Session(std::shared_ptr<Context> context, asio::ip::tcp::socket socket,
-                 std::string_view listener_bus)
+Session::Session(std::shared_ptr<Context> context, asio::generic::stream_protocol::socket socket,
+                 std::string_view listener_bus, std::string peer)
     : ctx_(std::move(context)),
       socket_(std::move(socket)),
-      drain_timer_(socket_.get_executor()),
-      settle_timer_(socket_.get_executor()) {
-  asio::error_code ec;
-  const auto peer = socket_.remote_endpoint(ec);
-  peer_ = ec ? std::string("unknown peer") : peer.address().to_string() + ":" + std::to_string(peer.port());
-  name_ = "socketcand " + std::string(listener_bus) + " " + peer_;
+      peer_(std::move(peer)),
+      name_("socketcand " + std::string(listener_bus) + " " + peer_) {
+  drain_timer_.emplace(ctx_->scheduler, [this] { OnDrainTimeout(); });
+  settle_timer_.emplace(ctx_->scheduler, [this] {
+    if (!ctx_->stopped) ReleaseHeld();
+  });
 }
 
 Session::~Session() {
@@ -54,8 +54,6 @@ Session::~Session() {
 }
 
 void Session::Start() {
-  asio::error_code ec;
-  socket_.set_option(asio::ip::tcp::no_delay(true), ec);  // as socketcand: one frame, one segment
   spdlog::info("{}: connected", name_);
   Reply("< hi >", false);
   Read();
@@ -69,10 +67,10 @@ void Session::Close(std::string_view reason) {
     ctx_->broker.Detach(port_);
     port_ = 0;
   }
-  settle_timer_.cancel();
-  drain_timer_.cancel();
+  settle_timer_.reset();
+  drain_timer_.reset();
   asio::error_code ec;
-  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
+  socket_.shutdown(asio::socket_base::shutdown_both, ec);
   socket_.close(ec);
   if (ctx_->stats.sessions_open > 0) --ctx_->stats.sessions_open;
 }
@@ -141,18 +139,15 @@ void Session::CheckDrained() {
     Close("client closed the connection");
     return;
   }
-  if (drain_timer_armed_) return;
-  drain_timer_armed_ = true;
-  drain_timer_.expires_after(
-      std::chrono::duration_cast<std::chrono::steady_clock::duration>(ctx_->options.drain_timeout));
-  drain_timer_.async_wait([self = shared_from_this()](const asio::error_code& ec) {
-    if (ec || self->closed_ || self->ctx_->stopped) return;
-    const std::size_t left = self->port_ == 0 ? 0 : self->ctx_->broker.Port(self->port_).queued;
-    const auto ms =
-        std::chrono::duration_cast<std::chrono::milliseconds>(self->ctx_->options.drain_timeout).count();
-    self->Close("client closed the connection; " + std::to_string(left) +
-                " of its frames were still queued after " + std::to_string(ms) + " ms and are dropped");
-  });
+  if (!drain_timer_->Armed()) drain_timer_->StartAfter(ctx_->options.drain_timeout);
+}
+
+void Session::OnDrainTimeout() {
+  if (closed_ || ctx_->stopped) return;
+  const std::size_t left = port_ == 0 ? 0 : ctx_->broker.Port(port_).queued;
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(ctx_->options.drain_timeout).count();
+  Close("client closed the connection; " + std::to_string(left) + " of its frames were still queued after " +
+        std::to_string(ms) + " ms and are dropped");
 }
 
 void Session::Handle(std::string_view element) {
@@ -197,7 +192,7 @@ void Session::Handle(std::string_view element) {
       holding_ = false;
       settle_after_.reset();
       held_.clear();
-      settle_timer_.cancel();
+      settle_timer_->Cancel();
       Reply("< ok >", false);
       return;
     case CommandKind::kEcho:
@@ -387,13 +382,7 @@ void Session::OnWrite(const asio::error_code& ec, std::size_t n) {
   written_bytes_ += n;
   if (settle_after_ && written_bytes_ >= *settle_after_) {
     settle_after_.reset();
-    if (holding_) {
-      settle_timer_.expires_after(
-          std::chrono::duration_cast<std::chrono::steady_clock::duration>(ctx_->options.raw_settle));
-      settle_timer_.async_wait([self = shared_from_this()](const asio::error_code& timer_ec) {
-        if (!timer_ec && !self->ctx_->stopped) self->ReleaseHeld();
-      });
-    }
+    if (holding_) settle_timer_->StartAfter(ctx_->options.raw_settle);
   }
   Write();
 }

@@ -22,14 +22,15 @@
 /// port until the frames it sent are on the wire (at most ServerOptions::drain_timeout).
 
 #include <array>
-#include <asio/ip/tcp.hpp>
-#include <asio/steady_timer.hpp>
+#include <asio/generic/stream_protocol.hpp>
+#include <asio/io_context.hpp>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
+#include "clock/scheduler.hpp"
 #include "orchestrator/broker/port_sink.hpp"
 #include "orchestrator/socketcand/protocol.hpp"
 #include "orchestrator/socketcand/server.hpp"
@@ -41,11 +42,12 @@ class Session;
 /// What the server and its listeners and sessions share. Handlers hold it by shared_ptr, so it
 /// outlives the Server while operations are pending; `stopped` tells them to do nothing.
 struct Context {
-  Context(asio::io_context& io_context, broker::Broker& b, ServerOptions o)
-      : io(io_context), broker(b), options(std::move(o)) {}
+  Context(asio::io_context& io_context, broker::Broker& b, Scheduler& s, ServerOptions o)
+      : io(io_context), broker(b), scheduler(s), options(std::move(o)) {}
 
   asio::io_context& io;
   broker::Broker& broker;
+  Scheduler& scheduler;  ///< the broker's: every timer of the endpoint
   ServerOptions options;
   WallTime origin{};
   std::vector<std::string> buses;  ///< the buses served
@@ -58,9 +60,10 @@ struct Context {
 
 class Session final : public broker::PortSink, public std::enable_shared_from_this<Session> {
  public:
-  /// `listener_bus`: the bus of the port the client connected to, for log lines
-  /// ("socketcand can0 127.0.0.1:40312: ...").
-  Session(std::shared_ptr<Context> context, asio::ip::tcp::socket socket, std::string_view listener_bus);
+  /// `listener_bus`: the bus of the port the client connected to, and `peer` the client
+  /// ("127.0.0.1:40312"), for log lines ("socketcand can0 127.0.0.1:40312: ...").
+  Session(std::shared_ptr<Context> context, asio::generic::stream_protocol::socket socket,
+          std::string_view listener_bus, std::string peer);
   ~Session() override;
 
   /// Greets the client and starts reading.
@@ -84,6 +87,7 @@ class Session final : public broker::PortSink, public std::enable_shared_from_th
   /// before the socket closed), at most ServerOptions::drain_timeout.
   void StartDrain();
   void CheckDrained();
+  void OnDrainTimeout();
   void Handle(std::string_view element);
   void Open(std::string_view bus);
   void SubmitFrame(const CanFrame& frame);
@@ -101,7 +105,7 @@ class Session final : public broker::PortSink, public std::enable_shared_from_th
   void OnWrite(const asio::error_code& ec, std::size_t n);
 
   std::shared_ptr<Context> ctx_;
-  asio::ip::tcp::socket socket_;
+  asio::generic::stream_protocol::socket socket_;
   std::string peer_;  ///< "127.0.0.1:40312"
   std::string name_;  ///< prefix of log lines
   Mode mode_ = Mode::kNoBus;
@@ -112,11 +116,10 @@ class Session final : public broker::PortSink, public std::enable_shared_from_th
   bool reading_ = false;
   bool paused_ = false;  ///< not executing commands: the port's TX backlog is full
   bool draining_ = false;
-  bool drain_timer_armed_ = false;
-  /// Real-time I/O timeouts (client handshake, lingering after a close): Asio timers on the
-  /// connection's executor, not Scheduler timers. They concern the TCP peer, not the bus, and
-  /// live as long as the connection's pending operations.
-  asio::steady_timer drain_timer_;
+  /// ServerOptions::drain_timeout, from the first check after the client closed its side. The
+  /// session's timers are destroyed by Close(): the session itself may outlive the scheduler
+  /// (pending I/O handlers hold it), its timers may not.
+  std::optional<Timer> drain_timer_;
   std::size_t tx_backlog_ = 0;
 
   std::string pending_;  ///< queued for the client
@@ -132,7 +135,7 @@ class Session final : public broker::PortSink, public std::enable_shared_from_th
   bool holding_ = false;
   std::optional<std::uint64_t> settle_after_;
   std::string held_;
-  asio::steady_timer settle_timer_;
+  std::optional<Timer> settle_timer_;
 
   bool closing_ = false;  ///< close once everything queued is written
   std::string closing_reason_;

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "bus/wire/tcp_endpoint_text.hpp"
-#include "orchestrator/transport/session.hpp"
+#include "orchestrator/transport/node_session.hpp"
 #include "orchestrator/transport/unix_socket_path.hpp"
 
 namespace canfleet::transport {
@@ -23,7 +23,7 @@ constexpr std::chrono::milliseconds kAcceptRetry{100};
 
 }  // namespace
 
-BrokerServer::BrokerServer(asio::io_context& io, broker::Broker& broker, ServerOptions options)
+BrokerServer::BrokerServer(asio::io_context& io, broker::Broker& broker, BrokerServerOptions options)
     : io_(io), broker_(broker), options_(options) {}
 
 BrokerServer::~BrokerServer() {
@@ -114,8 +114,8 @@ void BrokerServer::OnAccept(const asio::error_code& ec, std::string peer,
   }
   stats_->accepted++;
   const std::string label = "session " + std::to_string(next_session_++) + " (" + peer + ")";
-  auto session = std::make_shared<detail::Session>(
-      broker_, options_, stats_, std::move(socket), label, [this](detail::Session* s) { Remove(s); },
+  auto session = std::make_shared<detail::NodeSession>(
+      broker_, options_, stats_, std::move(socket), label, [this](detail::NodeSession* s) { Remove(s); },
       &next_attach_);
   sessions_.emplace(session.get(), session);
   session->Start();
@@ -124,7 +124,7 @@ void BrokerServer::OnAccept(const asio::error_code& ec, std::string peer,
 void BrokerServer::RequestNode(std::string_view bus, std::string_view node_name, wire::NodeRequest request,
                                NodeReplyHandler done) {
   stats_->node_requests++;
-  detail::Session* target = nullptr;
+  detail::NodeSession* target = nullptr;
   for (const auto& [ptr, session] : sessions_) {
     if (!session->Attached() || session->Bus() != bus || session->NodeName() != node_name) continue;
     if (target == nullptr || session->AttachOrder() > target->AttachOrder()) target = ptr;
@@ -137,7 +137,7 @@ void BrokerServer::RequestNode(std::string_view bus, std::string_view node_name,
   target->Request(std::move(request), std::move(done));
 }
 
-void BrokerServer::Remove(detail::Session* session) {
+void BrokerServer::Remove(detail::NodeSession* session) {
   sessions_.erase(session);
 }
 
@@ -155,7 +155,7 @@ void BrokerServer::Close() {
   auto sessions = std::move(sessions_);
   sessions_.clear();
   for (auto& [ptr, session] : sessions)
-    session->Close("broker shutting down", detail::Session::Farewell::kError, spdlog::level::debug);
+    session->Close("broker shutting down", detail::NodeSession::Farewell::kError, spdlog::level::debug);
 }
 
 }  // namespace canfleet::transport

@@ -23,10 +23,10 @@
 namespace canfleet::transport {
 
 namespace detail {
-class Session;
+class NodeSession;
 }
 
-struct ServerOptions {
+struct BrokerServerOptions {
   /// Bytes a session may have waiting for a slow reader; deliveries beyond it are dropped and
   /// counted (a receiver that does not read loses frames, like a CAN controller's overrun).
   std::size_t max_backlog_bytes = std::size_t{64} << 20;
@@ -39,7 +39,7 @@ struct ServerOptions {
   std::chrono::milliseconds node_request_timeout{3'000};
 };
 
-struct ServerStats {
+struct BrokerServerStats {
   std::uint64_t accepted = 0;         ///< connections accepted
   std::uint64_t attached = 0;         ///< Hellos accepted
   std::uint64_t refused = 0;          ///< Hellos refused (version, unknown bus, bad names)
@@ -56,7 +56,7 @@ struct ServerStats {
 
 /// Called once per RequestNode: the node's reply, or nullopt when no node of that name is
 /// attached to that bus, it disconnected first, or it did not answer within
-/// ServerOptions::node_request_timeout.
+/// BrokerServerOptions::node_request_timeout.
 using NodeReplyHandler = std::function<void(std::optional<wire::NodeReply>)>;
 
 /// Accepts connections and runs one session per connection: a valid Hello attaches a port to the
@@ -69,7 +69,7 @@ using NodeReplyHandler = std::function<void(std::optional<wire::NodeReply>)>;
 /// scheduler (AsioScheduler on the same io_context).
 class BrokerServer {
  public:
-  BrokerServer(asio::io_context& io, broker::Broker& broker, ServerOptions options = {});
+  BrokerServer(asio::io_context& io, broker::Broker& broker, BrokerServerOptions options = {});
   /// Closes every session (detaching their ports) and the listeners.
   ~BrokerServer();
   BrokerServer(const BrokerServer&) = delete;
@@ -98,25 +98,26 @@ class BrokerServer {
 
   std::size_t SessionCount() const { return sessions_.size(); }
   const std::vector<wire::Endpoint>& Endpoints() const { return endpoints_; }
-  const ServerStats& Stats() const { return *stats_; }
+  const BrokerServerStats& Stats() const { return *stats_; }
 
  private:
   void AcceptTcp(std::size_t index);
   void AcceptUnix(std::size_t index);
   void OnAccept(const asio::error_code& ec, std::string peer, asio::generic::stream_protocol::socket socket);
-  void Remove(detail::Session* session);
+  void Remove(detail::NodeSession* session);
 
   asio::io_context& io_;
   broker::Broker& broker_;
-  ServerOptions options_;
-  std::shared_ptr<ServerStats> stats_ = std::make_shared<ServerStats>();  ///< shared with the sessions
+  BrokerServerOptions options_;
+  std::shared_ptr<BrokerServerStats> stats_ =
+      std::make_shared<BrokerServerStats>();  ///< shared with the sessions
   /// Owned by the server alone: acceptor handlers that outlive it see it expired.
   std::shared_ptr<int> alive_ = std::make_shared<int>(0);
   std::vector<std::unique_ptr<asio::ip::tcp::acceptor>> tcp_;
   std::vector<std::unique_ptr<asio::local::stream_protocol::acceptor>> unix_;
   std::vector<std::string> unix_paths_;  ///< socket files to remove on Close
   std::vector<wire::Endpoint> endpoints_;
-  std::unordered_map<detail::Session*, std::shared_ptr<detail::Session>> sessions_;
+  std::unordered_map<detail::NodeSession*, std::shared_ptr<detail::NodeSession>> sessions_;
   std::uint64_t next_session_ = 1;
   std::uint64_t next_attach_ = 1;  ///< attach order of sessions (RequestNode picks the latest)
   bool closed_ = false;

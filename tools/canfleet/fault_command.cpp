@@ -1,8 +1,12 @@
 // canfleet fault inject KIND ..., fault clear [ID] [--label L] [--all], fault list [--all] [--json]
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <string_view>
+#include <vector>
 
+#include "orchestrator/control/fault_kinds.hpp"
 #include "orchestrator/control/fault_text.hpp"
 #include "tools/canfleet/cli.hpp"
 #include "tools/canfleet/text_format.hpp"
@@ -89,21 +93,34 @@ CLI::Validator FaultKindValidator() {
       "KIND");
 }
 
-/// The footer of `fault inject --help`: what each kind does (canfleet_control.proto, FaultKind).
-constexpr const char* kKindsHelp = R"(Kinds:
-  bus-off         --node's controller goes bus-off (recovers unless --manual-recovery)
-  heartbeat-loss  --node's heartbeat is not delivered (to --receiver nodes, or all)
-  rpdo-timeout    frames --cob-id no longer reach --node
-  drop            frames from --node (or any node) matching --cob-id/--mask are dropped
-  delay           ... delayed by --delay plus 0..--jitter
-  corrupt         ... destroyed by an error frame (TEC/REC consequences)
-  duplicate       ... received twice
-  partition       --group sets of nodes on --bus no longer hear each other
-  babbling-idiot  --node floods --cob-id (default 0x001) at the bus's full rate
-  error-passive   --node's controller is held error-passive
-  kill            --node's process is killed until the fault is cleared
-  restart         --node's process is stopped and started again
-  power-cycle     --node's process is killed and started again)";
+/// The footer of `fault inject --help`: what each kind does, from the table of fault kinds
+/// (orchestrator/control/fault_kinds.hpp), which also says what each kind takes: the orchestrator
+/// refuses an option that does not apply.
+std::string KindsHelp() {
+  std::string out = "Kinds:";
+  for (const control::FaultKindTraits& k : control::FaultKinds()) {
+    std::string name(k.name);
+    name.resize(std::max<std::size_t>(name.size() + 2, 16), ' ');
+    out += "\n  " + name + std::string(k.help);
+  }
+  return out;
+}
+
+std::string Join(const std::vector<std::string_view>& names) {
+  std::string out;
+  for (const std::string_view name : names)
+    out += (out.empty() ? "" : ", ") + std::string(name);
+  return out;
+}
+
+/// "heartbeat-loss, drop, delay: " + what, or "all kinds but restart, power-cycle: " + what: an
+/// option's help, naming the kinds that take it.
+std::string For(control::FaultOption option, const std::string& what) {
+  std::vector<std::string_view> takes, refuses;
+  for (const control::FaultKindTraits& k : control::FaultKinds())
+    (k.takes.Has(option) ? takes : refuses).push_back(k.name);
+  return (refuses.size() < takes.size() ? "all kinds but " + Join(refuses) : Join(takes)) + ": " + what;
+}
 
 void AddInject(CLI::App& fault, Cli& cli) {
   auto a = std::make_shared<InjectArgs>();
@@ -112,32 +129,47 @@ void AddInject(CLI::App& fault, Cli& cli) {
   auto* node = inject->add_option("--node", a->node, "The node concerned (see the kinds below)");
   inject->add_option("NODE", a->node, "The same as --node")->excludes(node);
   inject->add_option("--bus", a->bus, "The bus (default: the node's first bus)");
+  using control::FaultOption;
   inject
       ->add_option("--receiver", a->receivers,
-                   "heartbeat-loss, drop, delay: only this node misses the frames (repeatable; default all)")
+                   For(FaultOption::kReceivers, "only this node misses the frames (repeatable; default all)"))
       ->allow_extra_args(false);
-  inject->add_option("--cob-id", a->cob_id, "Identifier the fault matches, in hex (0x185 or 185h)")
-      ->check(HexValidator(0x1FFFFFFF));
-  inject->add_option("--mask", a->mask, "Identifier mask, in hex (default: exact match)")
-      ->check(HexValidator(0x1FFFFFFF));
-  inject->add_flag("--extended", a->extended, "--cob-id is a 29-bit identifier");
-  inject->add_option("--probability", a->probability, "Chance that a matching frame is hit (default 1)")
-      ->check(CLI::Range(0.0, 1.0));
-  inject->add_option("--seed", a->seed, "Seed of the random draws (reproducible runs)");
-  inject->add_option("--delay", a->delay, "delay: fixed delay (10ms)")->check(DurationValidator());
-  inject->add_option("--jitter", a->jitter, "delay: random extra delay, 0..JITTER (5ms)")
-      ->check(DurationValidator());
-  inject->add_option("--duration", a->duration, "End the fault after this long (5s; default: until cleared)")
-      ->check(DurationValidator());
-  inject->add_option("--count", a->count, "Frame faults: end after hitting this many frames");
   inject
-      ->add_option("--group", a->groups, "partition: one group of nodes, comma-separated (repeat per group)")
+      ->add_option("--cob-id", a->cob_id,
+                   For(FaultOption::kCobId, "identifier the fault matches, in hex (0x185 or 185h)"))
+      ->check(HexValidator(0x1FFFFFFF));
+  inject
+      ->add_option("--mask", a->mask,
+                   For(FaultOption::kMask, "identifier mask, in hex (default: exact match)"))
+      ->check(HexValidator(0x1FFFFFFF));
+  inject->add_flag(
+      "--extended", a->extended,
+      For(FaultOption::kExtended, "--cob-id is a 29-bit identifier (without it: 29-bit frames only)"));
+  inject
+      ->add_option("--probability", a->probability,
+                   For(FaultOption::kProbability, "chance that a matching frame is hit (default 1)"))
+      ->check(CLI::Range(0.0, 1.0));
+  inject->add_option("--seed", a->seed,
+                     For(FaultOption::kSeed, "seed of the random draws (reproducible runs)"));
+  inject->add_option("--delay", a->delay, For(FaultOption::kDelay, "fixed delay (10ms)"))
+      ->check(DurationValidator());
+  inject->add_option("--jitter", a->jitter, For(FaultOption::kJitter, "random extra delay, 0..JITTER (5ms)"))
+      ->check(DurationValidator());
+  inject
+      ->add_option("--duration", a->duration,
+                   For(FaultOption::kDuration,
+                       "end the fault after this long (5s; default: until cleared); bus-off: held this long"))
+      ->check(DurationValidator());
+  inject->add_option("--count", a->count, For(FaultOption::kCount, "end after hitting this many frames"));
+  inject
+      ->add_option("--group", a->groups,
+                   For(FaultOption::kGroups, "one group of nodes, comma-separated (repeat per group)"))
       ->allow_extra_args(false);
   inject->add_flag("--manual-recovery", a->manual_recovery,
-                   "bus-off: stay bus-off until the fault is cleared");
+                   For(FaultOption::kManualRecovery, "stay bus-off until the fault is cleared"));
   inject->add_option("--label", a->label, "A name to clear the fault by");
   inject->add_flag("--json", a->json, "Print the FaultInjected message as JSON");
-  inject->footer(kKindsHelp);
+  inject->footer(KindsHelp());
   inject->callback([&cli, a] { cli.action = [&cli, a] { return RunInject(cli.global, *a); }; });
 }
 

@@ -52,7 +52,9 @@ std::string Process(const control::NodeStatus& node) {
   return text;
 }
 
-std::string LastEmcy(const control::NodeStatus& node) {
+/// `node` is a NodeStatus or a PortStatus.
+template <class Node>
+std::string LastEmcy(const Node& node) {
   if (!node.has_last_emcy()) return "-";
   const control::Emcy& e = node.last_emcy();
   std::string text = Hex4(e.code()) + "h reg " + Hex2(e.register_()) + "h at " + FormatSeconds(e.time_s());
@@ -152,11 +154,26 @@ std::string FormatStatus(const control::Status& status) {
                  "HEARTBEAT", "LAST EMCY"});
     for (const std::size_t c : {2u, 5u, 8u, 9u, 10u})
       nodes.AlignRight(c);
-    for (const auto& n : status.nodes())
+    for (const auto& n : status.nodes()) {
+      if (n.ports_size() > 1) {
+        // One row per CAN port: each has its own node-ID, NMT state, controller and EMCYs.
+        for (int p = 0; p < n.ports_size(); ++p) {
+          const auto& port = n.ports(p);
+          const bool first = p == 0;
+          nodes.AddRow({first ? n.name() : "  port " + std::to_string(p + 1), first ? n.device() : "",
+                        std::to_string(port.node_id()), port.bus(), first ? Process(n) : "",
+                        first && n.pid() != 0 ? std::to_string(n.pid()) : (first ? "-" : ""),
+                        port.nmt_state().empty() ? "-" : port.nmt_state(),
+                        port.controller().empty() ? "-" : port.controller(), std::to_string(port.tec()),
+                        std::to_string(port.rec()), FormatSeconds(port.heartbeat_age_s()), LastEmcy(port)});
+        }
+        continue;
+      }
       nodes.AddRow({n.name(), n.device(), Join(n.node_ids()), Join(n.buses()), Process(n),
                     n.pid() != 0 ? std::to_string(n.pid()) : "-", n.nmt_state().empty() ? "-" : n.nmt_state(),
                     n.controller().empty() ? "-" : n.controller(), std::to_string(n.tec()),
                     std::to_string(n.rec()), FormatSeconds(n.heartbeat_age_s()), LastEmcy(n)});
+    }
     out += nodes.Render();
   }
   out += "\n";

@@ -23,29 +23,6 @@ bool IsDigit(char c) {
   return c >= '0' && c <= '9';
 }
 
-/// CiA 306 §4.3: times are hh:mm(AM|PM). 24-hour times without AM/PM and a blank before AM/PM
-/// are accepted as vendor files use them.
-bool IsEdsTime(std::string_view text) {
-  std::size_t i = 0;
-  while (i < text.size() && IsDigit(text[i]))
-    ++i;
-  if (i < 1 || i > 2 || i + 3 > text.size() || text[i] != ':' || !IsDigit(text[i + 1]) ||
-      !IsDigit(text[i + 2])) {
-    return false;
-  }
-  auto rest = ToLowerAscii(TrimBlanks(text.substr(i + 3)));
-  return rest.empty() || rest == "am" || rest == "pm";
-}
-
-/// CiA 306 §4.3: dates are mm-dd-yyyy.
-bool IsEdsDate(std::string_view text) {
-  if (text.size() != 10 || text[2] != '-' || text[5] != '-') return false;
-  for (std::size_t i : {0, 1, 3, 4, 6, 7, 8, 9}) {
-    if (!IsDigit(text[i])) return false;
-  }
-  return true;
-}
-
 std::string Checked(const SectionReader& r, std::string_view key, bool (*valid)(std::string_view),
                     std::string_view format) {
   auto value = r.Value(key);
@@ -142,6 +119,26 @@ void ReadCommissioning(const SectionReader& r, EdsFile& out) {
 }
 
 }  // namespace
+
+bool IsEdsTime(std::string_view text) {
+  std::size_t i = 0;
+  while (i < text.size() && IsDigit(text[i]))
+    ++i;
+  if (i < 1 || i > 2 || i + 3 > text.size() || text[i] != ':' || !IsDigit(text[i + 1]) ||
+      !IsDigit(text[i + 2])) {
+    return false;
+  }
+  auto rest = ToLowerAscii(TrimBlanks(text.substr(i + 3)));
+  return rest.empty() || rest == "am" || rest == "pm";
+}
+
+bool IsEdsDate(std::string_view text) {
+  if (text.size() != 10 || text[2] != '-' || text[5] != '-') return false;
+  for (std::size_t i : {0, 1, 3, 4, 6, 7, 8, 9}) {
+    if (!IsDigit(text[i])) return false;
+  }
+  return true;
+}
 
 void ReadFileLevelSections(const EdsSections& sections, std::string_view file_name, EdsFile& out) {
   if (sections.file_info) ReadFileInfo(SectionReader(*sections.file_info, file_name), out.file_info);

@@ -6,18 +6,15 @@
 #include <optional>
 #include <string_view>
 
+#include "node/canopen/od/value_text.hpp"
+
 namespace canfleet::canopen {
 
-/// A parsed literal, before any type's range is applied.
-struct IntegerLiteral {
-  bool negative = false;
-  std::uint64_t magnitude = 0;
-  bool hex = false;  ///< written as 0x...: a signed type may take it as two's complement
-};
-
 /// Parses the whole of `text` (no blanks inside) as an integer literal; nullopt if it is not
-/// one or does not fit 64 bits.
-std::optional<IntegerLiteral> ParseIntegerLiteral(std::string_view text);
+/// one or does not fit 64 bits. The grammar is the value codec's (ValueSyntax::kEds).
+inline std::optional<IntegerLiteral> ParseIntegerLiteral(std::string_view text) {
+  return ReadIntegerLiteral(text, ValueSyntax::kEds);
+}
 
 /// A non-negative literal no greater than `max`, or nullopt.
 std::optional<std::uint64_t> ParseUnsignedLiteral(std::string_view text, std::uint64_t max);

@@ -1,7 +1,9 @@
 #pragma once
 /// @file Typed values as EDS/DCF files spell them (DefaultValue, ParameterValue, LowLimit,
 /// HighLimit), and back: integers with their type's range, "$NODEID" formulas, REAL32/REAL64,
-/// VISIBLE_STRING as text, OCTET_STRING/UNICODE_STRING/DOMAIN as hex digits.
+/// VISIBLE_STRING as text, OCTET_STRING/UNICODE_STRING/DOMAIN as hex digits. The values
+/// themselves go through the one value codec (node/canopen/od/value_text.hpp, ValueSyntax::kEds);
+/// this adds $NODEID, inline comments and the reader's messages. (IsIntegerType is there too.)
 
 #include <span>
 #include <stdexcept>
@@ -10,6 +12,7 @@
 
 #include "node/canopen/od/types.hpp"
 #include "node/canopen/od/value.hpp"
+#include "node/canopen/od/value_text.hpp"
 
 namespace canfleet::canopen {
 
@@ -25,9 +28,6 @@ struct EdsValue {
   /// CiA 306 "$NODEID+x" / "x+$NODEID" / "$NODEID": `bytes` holds x; the node-ID is added later.
   bool adds_node_id = false;
 };
-
-/// True for the types whose values are integers (and so may use $NODEID).
-bool IsIntegerType(DataType type);
 
 /// Parses `text` (a trimmed value, not empty) as a value of `type`, a known type (IsKnown).
 /// @param allow_node_id false where $NODEID has no meaning

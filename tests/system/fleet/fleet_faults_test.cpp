@@ -15,6 +15,8 @@
 // timeout, 8140h recovered from bus-off; see node/devices/quad_controller/quad_error_policy.hpp).
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "tests/system/fleet/fleet_harness.hpp"
 
 namespace canfleet::system_test {
@@ -173,6 +175,51 @@ TEST_F(FleetFaultsTest, BusOffWithManualRecoveryHoldsUntilCleared) {
         return n && n->controller() == "error-active" && n->heartbeat_age_s() < 1.0;
       },
       kLong));
+}
+
+// Through the real CLI: an option bus-off does not take is refused by the orchestrator with what
+// it takes (nothing is injected); `--duration` holds the bus-off: the node's controller shows
+// bus-off with TEC > 255 for the whole time while its recovery attempts fail (ISO 11898-1:2015
+// §12.1.4.2: 1408 bit times each, 5.6 ms at 250 kbit/s, counted as the fault's hits), then it
+// recovers by itself.
+TEST_F(FleetFaultsTest, BusOffHeldForADurationAndOptionsThatDoNotApplyAreRefused) {
+  const auto refused = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--cob-id", "0x185"});
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_EQ(
+      refused.err,
+      "canfleet: --cob-id does not apply to bus-off (it takes --node, --bus, --duration, --manual-recovery, "
+      "--label)\n");
+  EXPECT_EQ(fleet.Node(fleet.Status(), "quad-6")->controller(), "error-active");
+
+  const auto injected = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--duration", "2s"});
+  ASSERT_EQ(injected.exit_code, 0) << injected.err;
+  EXPECT_NE(
+      injected.out.find("bus-off of quad-6 on can0, held for 2s (every recovery attempt fails until then)"),
+      std::string::npos)
+      << injected.out;
+  // Its recovery attempts fail (the fault's hits count them) while it stays bus-off, counters shown.
+  const auto start = std::chrono::steady_clock::now();
+  control::Status held;
+  ASSERT_TRUE(WaitUntil(
+      [&] {
+        held = fleet.Status();
+        return held.faults_size() == 1 && held.faults(0).hits() > 10;
+      },
+      kLong))
+      << fleet.Log();
+  if (std::chrono::steady_clock::now() < start + std::chrono::milliseconds(1900)) {
+    const auto* n = fleet.Node(held, "quad-6");
+    EXPECT_EQ(n->controller(), "bus-off");
+    EXPECT_GT(n->tec(), 255u);
+  }
+  EXPECT_TRUE(WaitUntil(
+      [&] {
+        const auto later = fleet.Status();
+        const auto* n = fleet.Node(later, "quad-6");
+        return n && n->controller() == "error-active" && later.faults_size() == 0;
+      },
+      kLong))
+      << fleet.Log();
 }
 
 }  // namespace

@@ -37,7 +37,7 @@ void ExpectNoAllocationInSteadyState(bool paced) {
   a.id = broker.Attach("can0", "a", a);
   b.id = broker.Attach("can0", "b", b);
   c.id = broker.Attach("can0", "c", c);
-  broker.Faults("can0").Add({.id = 0x701, .mask = 0x7FF, .action = FaultAction::kDrop, .probability = 0.5});
+  broker.Faults("can0").Add({.id = 0x701, .mask = 0x7FF, .action = RuleAction::kDrop, .probability = 0.5});
   for (Echo* e : {&a, &b, &c})
     for (int i = 0; i < 8; ++i)
       broker.Submit(e->id, Frame("123#"));

@@ -1,7 +1,7 @@
 // Bus arbitration by identifier, ISO 11898-1:2015 §6.3 (bus access method) and the arbitration
 // field of §10.4: bit by bit, a dominant 0 overwrites a recessive 1 and a node that sends
 // recessive but reads dominant withdraws; the frame with the lowest arbitration field wins.
-#include "orchestrator/broker/wire_model.hpp"
+#include "bus/physics/wire_model.hpp"
 
 #include <gtest/gtest.h>
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "bus/frame_timing.hpp"
+#include "bus/physics/frame_timing.hpp"
 #include "clock/scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "tests/support/bus_probe.hpp"
@@ -28,7 +28,7 @@ inline std::string At(std::string_view frame, BusTime time) {
   return std::string(frame) + "@" + std::to_string(time.count());
 }
 
-/// Bus occupancy of a successful transfer of `text` at `bitrate`, via bus/frame_timing.hpp.
+/// Bus occupancy of a successful transfer of `text` at `bitrate`, via bus/physics/frame_timing.hpp.
 inline BusTime FrameTime(std::string_view text, std::uint32_t bitrate) {
   return BitTime(CountFrameBits(Frame(text)).total(), bitrate);
 }

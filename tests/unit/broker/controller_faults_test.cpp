@@ -1,13 +1,13 @@
 // Direct controller faults for the fleet manager (FaultStage): bus-off held until recovered on
 // command, a controller held error-passive, and the babbling idiot. Counting rules of
-// ISO 11898-1:2015 §12.1.4 (bus/fault_confinement.hpp); recovery after 128 × 11 recessive bits
+// ISO 11898-1:2015 §12.1.4 (bus/physics/fault_confinement.hpp); recovery after 128 × 11 recessive bits
 // (§12.1.4.2) unless held.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
+#include "bus/physics/wire_model.hpp"
 #include "orchestrator/broker/broker.hpp"
-#include "orchestrator/broker/wire_model.hpp"
 #include "tests/unit/broker/broker_test_support.hpp"
 
 namespace canfleet::broker {
@@ -78,7 +78,7 @@ TEST_F(ControllerFaults, HoldingABusOffPortCancelsItsAutomaticRecovery) {
 // Given a port driven bus-off by errors (32 corrupted attempts), holding it then keeps it off
 // past its automatic recovery; RecoverBusOff ends it.
 TEST_F(ControllerFaults, ABusOffReachedThroughErrorsCanBeHeld) {
-  faults.Add({.source = pa, .action = FaultAction::kCorrupt, .count = 32});
+  faults.Add({.source = pa, .action = RuleAction::kCorrupt, .count = 32});
   broker.Submit(pa, Frame("181#01"));
   const std::uint32_t c_bits = StuffedBits("181#01") + kCrcErrorTailBits;
   const BusTime bus_off_at = Bits(32 * c_bits + 16 * kSuspendTransmissionBits);
@@ -90,6 +90,86 @@ TEST_F(ControllerFaults, ABusOffReachedThroughErrorsCanBeHeld) {
   EXPECT_EQ(broker.Port(pa).controller.state, ControllerState::kBusOff);
   EXPECT_TRUE(broker.RecoverBusOff(pa));
   EXPECT_EQ(a.events.back().state, ControllerState::kErrorActive);
+}
+
+// ---- bus-off with a cause that persists ----------------------------------------------------------
+
+// Given a bus that recovers by itself, when a cause holds a port bus-off (HoldBusOff), then every
+// automatic recovery attempt (1408 bit times after the bus-off, then every 1408 bit times,
+// ISO 11898-1:2015 §12.1.4.2) fails and is counted, recovery on command fails too, the port stays
+// bus-off with TEC 256 and sends nothing throughout; when the cause ends, the next attempt
+// succeeds (error-active, TEC 0) and its frames flow again.
+TEST_F(ControllerFaults, ABusOffHeldByACauseFailsEveryRecoveryAttemptUntilReleased) {
+  s.Advance(1ms);
+  const BusTime off_at = s.Now().time_since_epoch();
+  const BusTime period = Bits(kBusOffRecoveryBits);  // 2.816 ms at 500 kbit/s
+  EXPECT_TRUE(faults.HoldBusOff(pa, true));
+  EXPECT_FALSE(faults.HoldBusOff(pa, true));  // already held
+  ASSERT_EQ(a.events.size(), 1u);
+  EXPECT_EQ(a.events[0].state, ControllerState::kBusOff);
+  EXPECT_EQ(a.events[0].tec, 256);
+
+  // Just before the third attempt: two have failed; state and counters are visible all along.
+  s.AdvanceTo(T(off_at + 3 * period - 1ns));
+  PortStats held = broker.Port(pa);
+  EXPECT_EQ(held.controller.state, ControllerState::kBusOff);
+  EXPECT_EQ(held.controller.tec, 256);
+  EXPECT_EQ(held.failed_recoveries, 2u);
+  EXPECT_EQ(a.events.size(), 1u) << "a failed attempt changes nothing the node could see";
+  EXPECT_EQ(broker.Submit(pa, Frame("181#01")), 0u);
+  EXPECT_FALSE(broker.RecoverBusOff(pa)) << "recovery on command fails while the cause lasts";
+  EXPECT_EQ(broker.Port(pa).failed_recoveries, 3u);
+  s.AdvanceTo(T(off_at + 3 * period));
+  EXPECT_EQ(broker.Port(pa).failed_recoveries, 4u);
+  EXPECT_EQ(broker.Port(pa).controller.state, ControllerState::kBusOff);
+
+  // The cause ends between two attempts: the next one, at 4 periods, succeeds.
+  s.Advance(period / 2);
+  EXPECT_TRUE(faults.HoldBusOff(pa, false));
+  EXPECT_FALSE(faults.HoldBusOff(pa, false));
+  EXPECT_EQ(broker.Port(pa).controller.state, ControllerState::kBusOff);
+  s.AdvanceTo(T(off_at + 4 * period));
+  ASSERT_EQ(a.events.size(), 2u);
+  EXPECT_EQ(a.events[1].state, ControllerState::kErrorActive);
+  EXPECT_EQ(a.events[1].tec, 0);
+  EXPECT_EQ(a.event_times[1], off_at + 4 * period);
+  EXPECT_EQ(broker.Port(pa).failed_recoveries, 4u);
+  broker.Submit(pa, Frame("181#02"));
+  s.Advance(1ms);
+  EXPECT_EQ(b.Ids(), (std::vector<std::string>{"181#02"}));
+}
+
+// Given a bus that recovers only on command, a port held by a cause is bus-off and makes no
+// attempts of its own; RecoverBusOff fails while the cause lasts and succeeds once it ended.
+TEST_F(ControllerFaults, OnABusWithoutAutomaticRecoveryOnlyTheCommandAttemptsIt) {
+  broker.AddBus({.name = "manual", .bitrate = kRate, .auto_recover = false});
+  RecordingSink m1{&s}, m2{&s};
+  const PortId p1 = broker.Attach("manual", "m1", m1);
+  broker.Attach("manual", "m2", m2);
+  FaultStage& manual = broker.Faults("manual");
+  EXPECT_TRUE(manual.HoldBusOff(p1, true));
+  s.Advance(1s);
+  EXPECT_EQ(broker.Port(p1).failed_recoveries, 0u);
+  EXPECT_FALSE(broker.RecoverBusOff(p1));
+  EXPECT_EQ(broker.Port(p1).failed_recoveries, 1u);
+  EXPECT_TRUE(manual.HoldBusOff(p1, false));
+  s.Advance(1s);
+  EXPECT_EQ(broker.Port(p1).controller.state, ControllerState::kBusOff);
+  EXPECT_TRUE(broker.RecoverBusOff(p1));
+  EXPECT_EQ(m1.States(),
+            (std::vector<ControllerState>{ControllerState::kBusOff, ControllerState::kErrorActive}));
+}
+
+// Given a port already bus-off through errors, a cause added then makes its pending automatic
+// attempt fail (no second bus-off event).
+TEST_F(ControllerFaults, ACauseAddedToABusOffPortMakesItsPendingAttemptFail) {
+  EXPECT_TRUE(faults.ForceBusOff(pa));
+  const BusTime off_at = s.Now().time_since_epoch();
+  EXPECT_TRUE(faults.HoldBusOff(pa, true));
+  EXPECT_EQ(a.events.size(), 1u);
+  s.AdvanceTo(T(off_at + Bits(kBusOffRecoveryBits)));
+  EXPECT_EQ(broker.Port(pa).controller.state, ControllerState::kBusOff);
+  EXPECT_EQ(broker.Port(pa).failed_recoveries, 1u);
 }
 
 // ---- error-passive held ---------------------------------------------------------------------
@@ -129,7 +209,7 @@ TEST_F(ControllerFaults, HeldErrorPassiveUntilReleased) {
 // 256 > 255, bus-off. The automatic recovery keeps the hold: error-passive with TEC 128.
 TEST_F(ControllerFaults, AHeldPortStillGoesBusOffAndRecoversErrorPassive) {
   faults.HoldErrorPassive(pa, true);
-  faults.Add({.source = pa, .action = FaultAction::kCorrupt, .count = 16});
+  faults.Add({.source = pa, .action = RuleAction::kCorrupt, .count = 16});
   broker.Submit(pa, Frame("181#01"));
   const std::uint32_t c_bits = StuffedBits("181#01") + kCrcErrorTailBits;
   // Error-passive throughout: 8 bits of suspend transmission after each attempt.
@@ -149,7 +229,7 @@ TEST_F(ControllerFaults, AHeldPortStillGoesBusOffAndRecoversErrorPassive) {
 // Released after errors raised TEC above 128, TEC still goes back to 127 (the fault is gone).
 TEST_F(ControllerFaults, ReleasingTheHoldCapsTecAt127) {
   faults.HoldErrorPassive(pa, true);
-  faults.Add({.source = pa, .action = FaultAction::kCorrupt, .count = 9});
+  faults.Add({.source = pa, .action = RuleAction::kCorrupt, .count = 9});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(10ms);
   ASSERT_EQ(broker.Port(pa).controller.tec, 128 + 9 * 8 - 1);  // 9 errors, then the success
@@ -162,6 +242,7 @@ TEST_F(ControllerFaults, ControllerFaultsOnAPortOfAnotherBusAreRefused) {
   broker.AddBus({.name = "can1"});
   const PortId other = broker.Attach("can1", "x", c);
   EXPECT_THROW(faults.ForceBusOff(other, true), std::invalid_argument);
+  EXPECT_THROW(faults.HoldBusOff(other, true), std::invalid_argument);
   EXPECT_THROW(faults.HoldErrorPassive(other, true), std::invalid_argument);
   EXPECT_THROW(faults.StartBabbling(other, Frame("001#")), std::invalid_argument);
   EXPECT_THROW(faults.StopBabbling(other), std::invalid_argument);

@@ -1,12 +1,12 @@
 // Error confinement on the broker's ports, ISO 11898-1:2015 §12.1.4 (the counting rules, via
-// bus/fault_confinement.hpp), §6.10 ACK, §6.11 automatic retransmission, §6.14 error-passive
+// bus/physics/fault_confinement.hpp), §6.10 ACK, §6.11 automatic retransmission, §6.14 error-passive
 // (suspend transmission), §6.15 bus-off, §12.1.4.2 bus-off recovery after 128 × 11 recessive bits.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
+#include "bus/physics/wire_model.hpp"
 #include "orchestrator/broker/broker.hpp"
-#include "orchestrator/broker/wire_model.hpp"
 #include "tests/unit/broker/broker_test_support.hpp"
 
 namespace canfleet::broker {
@@ -102,7 +102,7 @@ TEST_F(Confinement, AListenOnlyPortDoesNotAcknowledge) {
 TEST_F(Confinement, ACorruptRuleDrivesThePortBusOffAfter32AttemptsAndItRecoversAfter1408Bits) {
   const PortId pa = Add(a);
   const PortId pb = Add(b);
-  broker.Faults("can0").Add({.source = pa, .action = FaultAction::kCorrupt});
+  broker.Faults("can0").Add({.source = pa, .action = RuleAction::kCorrupt});
   const CanFrame frames[] = {Frame("181#01"), Frame("181#02")};
   broker.Submit(pa, frames);
   const std::uint32_t c_bits = StuffedBits("181#01") + kCrcErrorTailBits;
@@ -234,7 +234,7 @@ TEST_F(Confinement, AnErrorPassiveTransmitterLetsOthersGoFirst) {
   const PortId pb = Add(b);
   Add(c);
   // 17 corrupted attempts (TEC 136), then success: TEC 135, error-passive.
-  broker.Faults("can0").Add({.source = pa, .action = FaultAction::kCorrupt, .count = 17});
+  broker.Faults("can0").Add({.source = pa, .action = RuleAction::kCorrupt, .count = 17});
   broker.Submit(pa, Frame("100#"));
   s.Advance(100ms);
   ASSERT_EQ(broker.Port(pa).controller.tec, 135);
@@ -261,7 +261,7 @@ TEST_F(Confinement, ReceiversAreToldTheirOwnStateChanges) {
   a.on_event = [&](const ControllerEvent& e) {
     if (e.state == ControllerState::kErrorActive && e.tec == 0) broker.Submit(pa, Frame("181#01"));
   };
-  broker.Faults("can0").Add({.source = pa, .action = FaultAction::kCorrupt, .count = 128});
+  broker.Faults("can0").Add({.source = pa, .action = RuleAction::kCorrupt, .count = 128});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(1s);
   // REC reached 128 at the 128th error: error-passive; the rule is used up, so the 5th try is

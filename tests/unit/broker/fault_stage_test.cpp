@@ -31,7 +31,7 @@ class Faults : public ::testing::Test {
 
 // A dropped heartbeat is simply never seen; the transfer itself succeeded on the wire.
 TEST_F(Faults, DropByCobIdAndMask) {
-  stage().Add({.id = 0x700, .mask = 0x780, .action = FaultAction::kDrop});  // every heartbeat 701h..77Fh
+  stage().Add({.id = 0x700, .mask = 0x780, .action = RuleAction::kDrop});  // every heartbeat 701h..77Fh
   const CanFrame frames[] = {Frame("705#05"), Frame("181#01"), Frame("77F#7F")};
   broker.Submit(pa, frames);
   s.Advance(10ms);
@@ -44,7 +44,7 @@ TEST_F(Faults, DropByCobIdAndMask) {
 }
 
 TEST_F(Faults, DropOnlyForTheListedReceivers) {
-  stage().Add({.receivers = {pc}, .action = FaultAction::kDrop});
+  stage().Add({.receivers = {pc}, .action = RuleAction::kDrop});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(10ms);
   EXPECT_EQ(b.Ids(), (std::vector<std::string>{"181#01"}));
@@ -52,8 +52,8 @@ TEST_F(Faults, DropOnlyForTheListedReceivers) {
 }
 
 TEST_F(Faults, MatchBySourcePortAndFormat) {
-  stage().Add({.source = pa, .action = FaultAction::kDrop});
-  stage().Add({.extended = true, .action = FaultAction::kDrop});
+  stage().Add({.source = pa, .action = RuleAction::kDrop});
+  stage().Add({.extended = true, .action = RuleAction::kDrop});
   broker.Submit(pa, Frame("181#01"));
   broker.Submit(pb, Frame("182#02"));
   broker.Submit(pb, Frame("00000182#03"));
@@ -65,7 +65,7 @@ TEST_F(Faults, MatchBySourcePortAndFormat) {
 // Delayed frames are stamped with their delivery time and keep their order; other receivers and
 // the sender see the wire's times.
 TEST_F(Faults, DelayKeepsOrderAndStampsTheDeliveryTime) {
-  stage().Add({.receivers = {pb}, .action = FaultAction::kDelay, .delay = 5ms});
+  stage().Add({.receivers = {pb}, .action = RuleAction::kDelay, .delay = 5ms});
   const CanFrame frames[] = {Frame("181#01"), Frame("181#02")};
   broker.Submit(pa, frames);
   const BusTime e1 = FrameTime("181#01", kRate);
@@ -87,7 +87,7 @@ std::vector<BusTime> JitteredTimes(std::uint64_t seed) {
   RecordingSink a, b;
   const PortId pa = broker.Attach("can0", "a", a);
   broker.Attach("can0", "b", b);
-  broker.Faults("can0").Add({.action = FaultAction::kDelay, .delay = 1ms, .jitter = 500us, .seed = seed});
+  broker.Faults("can0").Add({.action = RuleAction::kDelay, .delay = 1ms, .jitter = 500us, .seed = seed});
   for (int i = 0; i < 20; ++i)
     broker.Submit(pa, CanFrame::Data(0x181, {static_cast<std::uint8_t>(i)}));
   s.Advance(1s);
@@ -121,7 +121,7 @@ TEST(FaultsSeeded, JitterIsDeterministicPerSeedAndBounded) {
 // Duplicate: the transfer is repeated once on the wire; receivers get two copies with their own
 // end-of-frame times, the sender one confirmation.
 TEST_F(Faults, DuplicateRepeatsTheTransferOnTheWire) {
-  stage().Add({.id = 0x181, .mask = 0x7FF, .action = FaultAction::kDuplicate, .count = 1});
+  stage().Add({.id = 0x181, .mask = 0x7FF, .action = RuleAction::kDuplicate, .count = 1});
   const CanFrame frames[] = {Frame("181#01"), Frame("181#02")};
   broker.Submit(pa, frames);
   s.Advance(10ms);
@@ -141,7 +141,7 @@ std::vector<std::string> DropWithProbability(std::uint64_t seed) {
   const PortId pa = broker.Attach("can0", "a", a);
   broker.Attach("can0", "b", b);
   const RuleId id =
-      broker.Faults("can0").Add({.action = FaultAction::kDrop, .probability = 0.25, .seed = seed});
+      broker.Faults("can0").Add({.action = RuleAction::kDrop, .probability = 0.25, .seed = seed});
   for (int i = 0; i < 1000; ++i)
     broker.Submit(pa,
                   CanFrame::Data(0x181, {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
@@ -162,8 +162,8 @@ TEST(FaultsSeeded, ProbabilityIsSeededAndRepeatable) {
 }
 
 TEST_F(Faults, ProbabilityZeroNeverFiresOneAlwaysFires) {
-  stage().Add({.receivers = {pb}, .action = FaultAction::kDrop, .probability = 0.0});
-  stage().Add({.receivers = {pc}, .action = FaultAction::kDrop, .probability = 1.0});
+  stage().Add({.receivers = {pb}, .action = RuleAction::kDrop, .probability = 0.0});
+  stage().Add({.receivers = {pc}, .action = RuleAction::kDrop, .probability = 1.0});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(10ms);
   EXPECT_EQ(b.Ids(), (std::vector<std::string>{"181#01"}));
@@ -171,7 +171,7 @@ TEST_F(Faults, ProbabilityZeroNeverFiresOneAlwaysFires) {
 }
 
 TEST_F(Faults, ARuleExpiresAfterItsCount) {
-  const RuleId id = stage().Add({.action = FaultAction::kDrop, .count = 3});
+  const RuleId id = stage().Add({.action = RuleAction::kDrop, .count = 3});
   for (int i = 1; i <= 5; ++i)
     broker.Submit(pa, CanFrame::Data(0x181, {static_cast<std::uint8_t>(i)}));
   s.Advance(250us);  // two frames of 110 µs sent
@@ -187,7 +187,7 @@ TEST_F(Faults, ARuleExpiresAfterItsCount) {
 // A rule with a lifetime applies to transfers that start within it (bus time).
 TEST_F(Faults, ARuleExpiresAfterItsLifetime) {
   s.Advance(1ms);
-  stage().Add({.action = FaultAction::kDrop, .lifetime = 2ms});
+  stage().Add({.action = RuleAction::kDrop, .lifetime = 2ms});
   ASSERT_EQ(stage().List().size(), 1u);
   EXPECT_EQ(stage().List()[0].expires, T(3ms));
   broker.Submit(pa, Frame("181#01"));  // starts at 1 ms: dropped
@@ -213,15 +213,15 @@ TEST(FaultsOnTheTimeLine, ARuleAppliesFromTheMomentItWasAdded) {
   broker.Submit(pa, frames);
   const BusTime e1 = FrameTime("181#01", kRate);
   s.SetNow(T(e1 - 1us));  // 181#01 is on the wire, 181#02 is not; nothing processed yet
-  broker.Faults("can0").Add({.action = FaultAction::kDrop});
+  broker.Faults("can0").Add({.action = RuleAction::kDrop});
   s.JumpTo(T(10ms));
   EXPECT_EQ(b.Ids(), (std::vector<std::string>{"181#01"}));
 }
 
 TEST_F(Faults, ListRemoveClear) {
-  const RuleId r1 = stage().Add({.action = FaultAction::kDrop});
-  const RuleId r2 = stage().Add({.id = 0x705, .mask = 0x7FF, .action = FaultAction::kDelay, .delay = 1ms});
-  const RuleId r3 = stage().Add({.action = FaultAction::kCorrupt, .count = 5});
+  const RuleId r1 = stage().Add({.action = RuleAction::kDrop});
+  const RuleId r2 = stage().Add({.id = 0x705, .mask = 0x7FF, .action = RuleAction::kDelay, .delay = 1ms});
+  const RuleId r3 = stage().Add({.action = RuleAction::kCorrupt, .count = 5});
   EXPECT_EQ(r1, 1u);
   EXPECT_EQ(r2, 2u);
   EXPECT_EQ(r3, 3u);
@@ -231,18 +231,18 @@ TEST_F(Faults, ListRemoveClear) {
   ASSERT_EQ(list.size(), 2u);
   EXPECT_EQ(list[0].id, r1);
   EXPECT_EQ(list[1].id, r3);
-  EXPECT_EQ(list[1].rule.action, FaultAction::kCorrupt);
+  EXPECT_EQ(list[1].rule.action, RuleAction::kCorrupt);
   EXPECT_EQ(list[1].remaining, 5u);
   stage().Clear();
   EXPECT_TRUE(stage().List().empty());
   EXPECT_EQ(stage().Add({}), 4u);  // ids are never reused
-  EXPECT_STREQ(ToString(FaultAction::kDuplicate), "duplicate");
+  EXPECT_STREQ(ToString(RuleAction::kDuplicate), "duplicate");
 }
 
 TEST_F(Faults, InvalidRulesAreRefused) {
   EXPECT_THROW(stage().Add({.probability = 1.5}), std::invalid_argument);
   EXPECT_THROW(stage().Add({.probability = -0.1}), std::invalid_argument);
-  EXPECT_THROW(stage().Add({.action = FaultAction::kDelay, .delay = -1ms}), std::invalid_argument);
+  EXPECT_THROW(stage().Add({.action = RuleAction::kDelay, .delay = -1ms}), std::invalid_argument);
   EXPECT_THROW(stage().Add({.lifetime = 0ms}), std::invalid_argument);
   EXPECT_THROW(stage().Add({.count = 0}), std::invalid_argument);
   EXPECT_TRUE(stage().List().empty());
@@ -250,7 +250,7 @@ TEST_F(Faults, InvalidRulesAreRefused) {
 
 // A delayed frame whose receiver has gone is simply not delivered.
 TEST_F(Faults, ADelayedFrameForADetachedPortIsDiscarded) {
-  stage().Add({.receivers = {pb}, .action = FaultAction::kDelay, .delay = 5ms});
+  stage().Add({.receivers = {pb}, .action = RuleAction::kDelay, .delay = 5ms});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(1ms);
   EXPECT_TRUE(broker.Detach(pb));

@@ -1,4 +1,4 @@
-// Paced buses: the wire's time line. Frame lengths from bus/frame_timing.hpp (ISO 11898-1:2015
+// Paced buses: the wire's time line. Frame lengths from bus/physics/frame_timing.hpp (ISO 11898-1:2015
 // §10.4 frame formats, §10.5 bit stuffing, 3 bits of intermission counted in each frame); a frame
 // pending during a transfer starts at the first bit after the intermission (§10.4 interframe space).
 #include <gtest/gtest.h>

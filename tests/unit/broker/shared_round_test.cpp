@@ -115,9 +115,9 @@ TEST(SharedRound, PerReceiverExceptions) {
   const PortId pc = broker.Attach("can0", "c", c);
   const PortId pm = broker.Attach("can0", "m", monitor, {.listen_only = true, .error_frames = true});
   FaultStage& faults = broker.Faults("can0");
-  faults.Add({.id = 0x181, .mask = 0x7FF, .receivers = {pb}, .action = FaultAction::kDrop});
-  faults.Add({.id = 0x182, .mask = 0x7FF, .receivers = {pc}, .action = FaultAction::kDelay, .delay = 20ms});
-  faults.Add({.id = 0x183, .mask = 0x7FF, .action = FaultAction::kCorrupt, .count = 1});
+  faults.Add({.id = 0x181, .mask = 0x7FF, .receivers = {pb}, .action = RuleAction::kDrop});
+  faults.Add({.id = 0x182, .mask = 0x7FF, .receivers = {pc}, .action = RuleAction::kDelay, .delay = 20ms});
+  faults.Add({.id = 0x183, .mask = 0x7FF, .action = RuleAction::kCorrupt, .count = 1});
   const CanFrame frames[] = {Frame("181#01"), Frame("182#02"), Frame("183#03")};
   broker.Submit(pa, frames);
   s.Advance(100ms);

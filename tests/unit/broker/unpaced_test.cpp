@@ -61,7 +61,7 @@ TEST_F(Unpaced, RepliesFromInsideDeliverGoInTheNextRound) {
 }
 
 TEST_F(Unpaced, CorruptionStillCountsAndBusOffStillStopsThePort) {
-  broker.Faults("fast").Add({.source = pa, .action = FaultAction::kCorrupt});
+  broker.Faults("fast").Add({.source = pa, .action = RuleAction::kCorrupt});
   broker.Submit(pa, Frame("181#01"));
   s.Advance(0ns);
   EXPECT_EQ(a.States(),

@@ -1,5 +1,5 @@
 // CAN controller fault confinement, ISO 11898-1 §12.1.4.
-#include "bus/fault_confinement.hpp"
+#include "bus/physics/fault_confinement.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Frame length on the wire, ISO 11898-1 §10.4 (frame format) and §10.5 (bit stuffing).
-#include "bus/frame_timing.hpp"
+#include "bus/physics/frame_timing.hpp"
 
 #include <gtest/gtest.h>
 

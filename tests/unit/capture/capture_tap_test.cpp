@@ -1,6 +1,6 @@
 // A capture is a listen-only port of a broker bus: it records every frame at its bus time on the
 // wall clock, error frames included, without changing the bus (ISO 11898-1 bus monitoring mode).
-#include "bus/capture/capture_tap.hpp"
+#include "orchestrator/capture/capture_tap.hpp"
 
 #include <gtest/gtest.h>
 

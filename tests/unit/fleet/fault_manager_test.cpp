@@ -78,7 +78,7 @@ TEST_F(FaultManagerTest, HeartbeatLossDropsTheNodesHeartbeatForTheChosenReceiver
   EXPECT_EQ(rules[0].rule.id, 0x705u);
   EXPECT_EQ(rules[0].rule.mask, 0x7FFu);
   EXPECT_EQ(rules[0].rule.receivers, std::vector<broker::PortId>{ports["quad-6"]});
-  EXPECT_EQ(rules[0].rule.action, broker::FaultAction::kDrop);
+  EXPECT_EQ(rules[0].rule.action, broker::RuleAction::kDrop);
 
   control::FaultClear clear;
   clear.set_fault_id(injected.fault_id());
@@ -164,6 +164,86 @@ TEST_F(FaultManagerTest, BusOffWithManualRecoveryHoldsUntilCleared) {
   EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kBusOff);
   faults->Clear({});
   EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kErrorActive);
+}
+
+// A bus-off held for a duration is a cause that persists: the node stays bus-off (TEC 256) for
+// the whole duration while its recovery attempts (every 1408 bit times = 5.632 ms at 250 kbit/s,
+// ISO 11898-1:2015 §12.1.4.2) fail and are counted as the fault's hits; then the next attempt
+// succeeds.
+TEST_F(FaultManagerTest, BusOffHeldForADurationFailsEveryRecoveryAttemptUntilItEnds) {
+  auto spec = Spec(control::BUS_OFF, "quad-5");
+  spec.set_duration_ms(100);
+  const auto injected = faults->Inject(spec);
+  EXPECT_EQ(injected.summary(),
+            "bus-off of quad-5 on can0, held for 100ms (every recovery attempt fails until then)");
+  for (int step = 0; step < 9; ++step) {
+    scheduler.Advance(11ms);
+    const auto port = broker.Port(ports["quad-5"]);
+    EXPECT_EQ(port.controller.state, ControllerState::kBusOff) << step;
+    EXPECT_EQ(port.controller.tec, 256) << step;
+  }
+  const auto active = faults->List(false);
+  ASSERT_EQ(active.size(), 1u);
+  EXPECT_EQ(active[0].state(), "active");
+  EXPECT_EQ(active[0].hits(), 17u);  // 99 ms / 5.632 ms
+  scheduler.Advance(1ms);            // 100 ms: the cause ends
+  EXPECT_EQ(faults->List(true).at(0).state(), "expired");
+  EXPECT_EQ(faults->List(true).at(0).hits(), 17u);
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kBusOff);
+  scheduler.Advance(std::chrono::microseconds(5632));  // the next attempt, 18 × 5.632 ms after the bus-off
+  EXPECT_EQ(sinks["quad-5"].state, ControllerState::kErrorActive);
+  EXPECT_EQ(events, (std::vector<std::string>{"+active", "-expired"}));
+}
+
+// Options a kind does not take, and forms of a kind that exclude each other, are refused with
+// the CLI's names (the control API's errors are printed by `canfleet`), and nothing is applied.
+TEST_F(FaultManagerTest, OptionsThatDoNotApplyAreRefusedNotIgnored) {
+  auto message = [&](const control::FaultSpec& spec) -> std::string {
+    try {
+      faults->Inject(spec);
+    } catch (const FaultError& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  auto bus_off = Spec(control::BUS_OFF, "quad-5");
+  bus_off.set_cob_id(0x185);
+  EXPECT_EQ(
+      message(bus_off),
+      "--cob-id does not apply to bus-off (it takes --node, --bus, --duration, --manual-recovery, --label)");
+  bus_off.clear_cob_id();
+  bus_off.set_manual_recovery(true);
+  bus_off.set_duration_ms(2000);
+  EXPECT_EQ(message(bus_off), "--duration and --manual-recovery are two forms of bus-off: give one");
+  auto corrupt = Spec(control::CORRUPT, "quad-5");
+  corrupt.add_receivers("quad-6");
+  EXPECT_EQ(message(corrupt).find("--receiver does not apply to corrupt (it takes"), 0u);
+  auto drop = Spec(control::DROP, "quad-5");
+  drop.set_delay_ms(10);
+  EXPECT_EQ(message(drop).find("--delay does not apply to drop (it takes"), 0u);
+  auto restart = Spec(control::RESTART, "quad-5");
+  restart.set_duration_ms(1000);
+  EXPECT_EQ(message(restart), "--duration does not apply to restart (it takes --node, --label)");
+  EXPECT_EQ(message(Spec(control::RPDO_TIMEOUT, "quad-6")),
+            "required: rpdo-timeout needs the COB-ID of the RPDO that stops reaching the node (--cob-id)");
+  EXPECT_TRUE(broker.Faults("can0").List().empty());
+  EXPECT_TRUE(faults->List(true).empty());
+  EXPECT_EQ(broker.Port(ports["quad-5"]).controller.state, ControllerState::kErrorActive);
+}
+
+// What the summary of heartbeat-loss has always said is now done: probability, seed and count
+// reach the broker's drop rule.
+TEST_F(FaultManagerTest, HeartbeatLossTakesProbabilitySeedAndCount) {
+  auto spec = Spec(control::HEARTBEAT_LOSS, "quad-5");
+  spec.set_probability(0.5);
+  spec.set_seed(7);
+  spec.set_count(3);
+  faults->Inject(spec);
+  const auto rules = broker.Faults("can0").List();
+  ASSERT_EQ(rules.size(), 1u);
+  EXPECT_EQ(rules[0].rule.probability, 0.5);
+  EXPECT_EQ(rules[0].rule.seed, 7u);
+  EXPECT_EQ(rules[0].rule.count, std::optional<std::uint64_t>(3));
 }
 
 TEST_F(FaultManagerTest, ErrorPassiveIsHeldAndReleased) {

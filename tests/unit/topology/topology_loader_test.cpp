@@ -455,6 +455,40 @@ TEST(TopologyScenarioTest, FaultSpecsAreSane) {
               HasSubstr("DELAY needs delay_ms or jitter_ms"));
 }
 
+// What each kind takes comes from one table (orchestrator/control/fault_kinds.hpp): an option a
+// kind does not take is refused with what it takes, never ignored; bus-off held for a duration is
+// a form of its own, exclusive with manual recovery.
+TEST(TopologyScenarioTest, OptionsAKindDoesNotTakeAreRefused) {
+  EXPECT_THAT(
+      Refusal(kTwoQuads + "scenario { inject { kind: BUS_OFF node: \"quad-5\" cob_id: 0x185 } }").what(),
+      HasSubstr("scenario[0].inject.cob_id: cob_id does not apply to BUS_OFF (it takes node, bus, "
+                "duration_ms, manual_recovery, label)"));
+  EXPECT_THAT(
+      Refusal(
+          kTwoQuads +
+          "scenario { inject { kind: BUS_OFF node: \"quad-5\" manual_recovery: true duration_ms: 2000 } }")
+          .what(),
+      HasSubstr("scenario[0].inject.manual_recovery: duration_ms and manual_recovery are two forms of "
+                "BUS_OFF: give one"));
+  EXPECT_THAT(Refusal(kTwoQuads + "scenario { inject { kind: CORRUPT receivers: \"quad-6\" } }").what(),
+              HasSubstr("scenario[0].inject.receivers: receivers does not apply to CORRUPT"));
+  EXPECT_THAT(
+      Refusal(kTwoQuads + "scenario { inject { kind: KILL node: \"quad-5\" bus: \"can0\" } }").what(),
+      HasSubstr("scenario[0].inject.bus: bus does not apply to KILL (it takes node, duration_ms, label)"));
+  EXPECT_THAT(Refusal(kTwoQuads + "scenario { inject { kind: DROP mask: 0x780 } }").what(),
+              HasSubstr("scenario[0].inject.mask: mask needs cob_id, the identifier it masks"));
+  EXPECT_THAT(
+      Refusal(kTwoQuads + "scenario { inject { kind: RESTART node: \"quad-5\" duration_ms: 100 } }").what(),
+      HasSubstr("scenario[0].inject.duration_ms: duration_ms does not apply to RESTART"));
+
+  const LoadedTopology held =
+      Load(kTwoQuads +
+           "scenario { inject { kind: BUS_OFF node: \"quad-5\" duration_ms: 2000 } }\n"
+           "scenario { inject { kind: KILL node: \"quad-6\" } }\n");
+  EXPECT_EQ(held.spec.scenario(0).inject().bus(), "can0");
+  EXPECT_EQ(held.spec.scenario(1).inject().bus(), "") << "a process fault takes no bus: none is filled in";
+}
+
 TEST(TopologyScenarioTest, LabelsAreUniqueAndClearedOnlyAfterTheirInjection) {
   const std::string inject =
       "scenario { at_ms: 1000 inject { kind: BUS_OFF node: \"quad-5\" label: \"off\" } }\n";
@@ -702,6 +736,28 @@ TEST(ShippedTopologiesTest, EachFaultExampleInjectsAndClearsItsFault) {
     }
     EXPECT_TRUE(injected);
     EXPECT_TRUE(cleared);
+  }
+}
+
+// Issue 18: the demo (and its container twin) runs the data logger on both buses, with the TC
+// limits of its README's demo configuration: they default to 0 and trip at room temperature
+// (UMAX181001 §3.4.22-3.4.26).
+TEST(ShippedTopologiesTest, TheDemosRunTheDataLoggerOnTwoBusesWithItsTcLimitsSet) {
+  for (const char* file : {"demo.textproto", "docker.textproto"}) {
+    SCOPED_TRACE(file);
+    const LoadedTopology t = LoadTopology(kTopologies / file);
+    const Node* logger = nullptr;
+    for (const Node& node : t.spec.node())
+      if (node.device() == "datalogger-tc-analog") logger = &node;
+    ASSERT_NE(logger, nullptr);
+    ASSERT_EQ(logger->bus_size(), 2);
+    EXPECT_NE(logger->bus(0), logger->bus(1));
+    for (const std::uint32_t index : {0x2171u, 0x2173u}) {
+      int subs = 0;
+      for (const auto& write : logger->sdo())
+        if (write.index() == index && write.value() != "0") ++subs;
+      EXPECT_EQ(subs, 4) << std::hex << index;
+    }
   }
 }
 

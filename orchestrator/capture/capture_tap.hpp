@@ -1,28 +1,24 @@
 #pragma once
 /// @file A capture attached to a broker bus: a port that only listens and writes every frame it
-/// sees to a CaptureWriter.
+/// sees to a CaptureWriter. Stamps are bus time + the process's wall-clock origin
+/// (clock/wall_clock.hpp), the same origin socketcand uses.
 
 #include <cstdint>
 #include <span>
 
 #include "bus/capture/capture_writer.hpp"
-#include "clock/scheduler.hpp"
+#include "clock/wall_clock.hpp"
 #include "orchestrator/broker/bus_config.hpp"
 #include "orchestrator/broker/port_sink.hpp"
 
 namespace canfleet::capture {
-
-/// The wall-clock time of the scheduler's time 0, read once from the system clock now; broker bus
-/// times (scheduler time) + this origin = the wall-clock times capture files and socketcand
-/// clients expect. An edge of the system: protocol code never reads the system clock.
-WallTime WallClockOrigin(const Scheduler& scheduler);
 
 /// Writes every frame delivered to its port, stamped origin + bus time. Attach it with
 /// CaptureTap::kAttachOptions: listen-only (it never acknowledges or transmits, so it does not
 /// change the bus it watches: a lone node still sees its ACK errors) and with error frames.
 ///
 ///     capture::PcapWriter pcap("can0.pcap");
-///     capture::CaptureTap tap(pcap, capture::WallClockOrigin(scheduler));
+///     capture::CaptureTap tap(pcap, WallClockOrigin(scheduler));  // or the host's one origin
 ///     auto port = broker.Attach("can0", "capture", tap, capture::CaptureTap::kAttachOptions);
 class CaptureTap final : public broker::PortSink {
  public:

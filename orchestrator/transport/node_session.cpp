@@ -1,4 +1,4 @@
-#include "orchestrator/transport/session.hpp"
+#include "orchestrator/transport/node_session.hpp"
 
 #include <array>
 #include <asio/post.hpp>
@@ -32,9 +32,10 @@ std::string JoinBuses(const std::vector<std::string>& names) {
 
 }  // namespace
 
-Session::Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
-                 asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed,
-                 std::uint64_t* attach_counter)
+NodeSession::NodeSession(broker::Broker& broker, const BrokerServerOptions& options,
+                         std::shared_ptr<BrokerServerStats> stats,
+                         asio::generic::stream_protocol::socket socket, std::string label,
+                         ClosedHandler on_closed, std::uint64_t* attach_counter)
     : broker_(broker),
       options_(options),
       stats_(std::move(stats)),
@@ -44,12 +45,12 @@ Session::Session(broker::Broker& broker, const ServerOptions& options, std::shar
       on_closed_(std::move(on_closed)),
       attach_counter_(attach_counter) {}
 
-Session::~Session() {
+NodeSession::~NodeSession() {
   // Close() detaches before the last reference goes; this only guards a session that never ran.
   if (port_ != 0 && !closed_) broker_.Detach(port_);
 }
 
-void Session::Start() {
+void NodeSession::Start() {
   spdlog::debug("{}: connected", label_);
   timer_.expires_after(options_.hello_timeout);
   timer_.async_wait([this, self = shared_from_this()](const asio::error_code& ec) {
@@ -61,7 +62,7 @@ void Session::Start() {
   Read();
 }
 
-void Session::Read() {
+void NodeSession::Read() {
   // One read, then (once the socket is drained) a wait for readiness; see bus/wire/socket_io.hpp.
   // The wait is armed in the same handler as the read that found the socket drained, so anything
   // that arrives later raises a readiness event the wait is there to see.
@@ -101,7 +102,7 @@ void Session::Read() {
   });
 }
 
-void Session::WaitReadable() {
+void NodeSession::WaitReadable() {
   socket_.async_wait(asio::socket_base::wait_read,
                      [this, self = shared_from_this()](const asio::error_code& ec) {
                        if (closed_) return;
@@ -113,7 +114,7 @@ void Session::WaitReadable() {
                      });
 }
 
-void Session::Handle(const wire::Message& m) {
+void NodeSession::Handle(const wire::Message& m) {
   using wire::MessageType;
   if (port_ == 0 && m.type != MessageType::kHello && m.type != MessageType::kPing &&
       m.type != MessageType::kError) {
@@ -157,7 +158,7 @@ void Session::Handle(const wire::Message& m) {
   }
 }
 
-void Session::Request(wire::NodeRequest request, NodeReplyHandler done) {
+void NodeSession::Request(wire::NodeRequest request, NodeReplyHandler done) {
   if (!Attached()) {
     asio::post(socket_.get_executor(), [done = std::move(done)] { done(std::nullopt); });
     return;
@@ -183,7 +184,7 @@ void Session::Request(wire::NodeRequest request, NodeReplyHandler done) {
   ScheduleFlush();
 }
 
-void Session::OnNodeReply(const wire::NodeReply& reply) {
+void NodeSession::OnNodeReply(const wire::NodeReply& reply) {
   auto it = pending_.find(reply.request_id());
   if (it == pending_.end()) {
     // Answered after its deadline (the caller was already told): nothing to do.
@@ -199,7 +200,7 @@ void Session::OnNodeReply(const wire::NodeReply& reply) {
   pending.done(std::move(answer));
 }
 
-void Session::FailPendingRequests() {
+void NodeSession::FailPendingRequests() {
   auto pending = std::move(pending_);
   pending_.clear();
   for (auto& [id, request] : pending) {
@@ -208,7 +209,7 @@ void Session::FailPendingRequests() {
   }
 }
 
-void Session::OnHello(const wire::Hello& hello) {
+void NodeSession::OnHello(const wire::Hello& hello) {
   if (hello.protocol_version() != wire::kProtocolVersion) {
     Refuse("protocol version " + std::to_string(hello.protocol_version()) +
            " not supported: this broker speaks version " + std::to_string(wire::kProtocolVersion));
@@ -265,7 +266,7 @@ void Session::OnHello(const wire::Hello& hello) {
                hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string());
 }
 
-void Session::Refuse(const std::string& reason) {
+void NodeSession::Refuse(const std::string& reason) {
   stats_->refused++;
   wire::HelloReply reply;
   reply.set_accepted(false);
@@ -275,12 +276,12 @@ void Session::Refuse(const std::string& reason) {
   Close("refused: " + reason, Farewell::kDrain, spdlog::level::warn);
 }
 
-void Session::ProtocolError(const std::string& reason) {
+void NodeSession::ProtocolError(const std::string& reason) {
   stats_->protocol_errors++;
   Close("protocol error: " + reason, Farewell::kError, spdlog::level::warn);
 }
 
-void Session::Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level) {
+void NodeSession::Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level) {
   if (closed_) return;
   const auto self = shared_from_this();  // on_closed_ drops the server's reference
   closed_ = true;
@@ -311,14 +312,14 @@ void Session::Close(const std::string& reason, Farewell farewell, spdlog::level:
   });
 }
 
-void Session::CloseSocket() {
+void NodeSession::CloseSocket() {
   asio::error_code ignored;
   timer_.cancel();
   socket_.shutdown(asio::socket_base::shutdown_both, ignored);
   socket_.close(ignored);
 }
 
-void Session::Deliver(std::span<const broker::TimedFrame> frames) {
+void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
   if (filling_.size() >= options_.max_backlog_bytes) {
     if (backlog_drops_ == 0) spdlog::warn("{}: not reading; dropping frames for it", label_);
     backlog_drops_ += frames.size();
@@ -329,7 +330,7 @@ void Session::Deliver(std::span<const broker::TimedFrame> frames) {
   ScheduleFlush();
 }
 
-void Session::DeliverShared(const broker::SharedRound& round, std::span<const broker::FrameRun> runs) {
+void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<const broker::FrameRun> runs) {
   std::size_t frames = 0;
   for (const broker::FrameRun& run : runs)
     frames += run.size();
@@ -352,8 +353,8 @@ void Session::DeliverShared(const broker::SharedRound& round, std::span<const br
   ScheduleFlush();
 }
 
-void Session::WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs,
-                            std::size_t frames) {
+void NodeSession::WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs,
+                                std::size_t frames) {
   // What is queued for this port goes first (a controller event earlier in the round, a pong),
   // then one Frames message: our header, then the runs straight from the round's encoding. The
   // kernel copies them into the socket; nothing is copied on the way (issue 4: a frame to 31
@@ -371,18 +372,18 @@ void Session::WriteGathered(const std::uint8_t* records, std::span<const broker:
   SendNow({buffers.data(), count});  // may close the session: nothing after it
 }
 
-void Session::ControllerChanged(const ControllerEvent& event) {
+void NodeSession::ControllerChanged(const ControllerEvent& event) {
   filling_.AddControllerEvent(event);
   ScheduleFlush();
 }
 
-void Session::TxConfirmed(std::span<const broker::TimedFrame> frames) {
+void NodeSession::TxConfirmed(std::span<const broker::TimedFrame> frames) {
   if (!tx_confirmations_) return;
   filling_.AddFrames(wire::MessageType::kTxConfirm, frames, Stamped);
   ScheduleFlush();
 }
 
-void Session::ScheduleFlush() {
+void NodeSession::ScheduleFlush() {
   if (flush_posted_ || write_in_flight_) return;
   flush_posted_ = true;
   asio::post(socket_.get_executor(), [this, self = shared_from_this()] {
@@ -391,14 +392,14 @@ void Session::ScheduleFlush() {
   });
 }
 
-void Session::Flush() {
+void NodeSession::Flush() {
   if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
   const std::span<const std::uint8_t> bytes = filling_.Bytes();
   const iovec buffer{const_cast<std::uint8_t*>(bytes.data()), bytes.size()};
   SendNow({&buffer, 1});
 }
 
-void Session::SendNow(std::span<const iovec> message) {
+void NodeSession::SendNow(std::span<const iovec> message) {
   std::error_code ec;
   const std::size_t sent = wire::SendNow(socket_.native_handle(), message, ec);
   stats_->writes++;
@@ -424,9 +425,9 @@ void Session::SendNow(std::span<const iovec> message) {
   WriteRest();
 }
 
-void Session::WriteRest() {
+void NodeSession::WriteRest() {
   // The slow path: the socket is full (a peer reading slower than the bus delivers). What is
-  // delivered meanwhile collects in filling_, up to ServerOptions::max_backlog_bytes.
+  // delivered meanwhile collects in filling_, up to BrokerServerOptions::max_backlog_bytes.
   write_in_flight_ = true;
   asio::async_write(socket_, Buffer(writing_.Bytes()),
                     [this, self = shared_from_this()](const asio::error_code& ec, std::size_t) {
@@ -447,7 +448,7 @@ void Session::WriteRest() {
                     });
 }
 
-void Session::Written() {
+void NodeSession::Written() {
   if (closed_) {
     CloseSocket();
     return;

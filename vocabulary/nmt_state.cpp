@@ -1,4 +1,4 @@
-#include "node/canopen/common/nmt_state.hpp"
+#include "vocabulary/nmt_state.hpp"
 
 namespace canfleet::canopen {
 

@@ -1,4 +1,4 @@
-#include "bus/fault_confinement.hpp"
+#include "bus/physics/fault_confinement.hpp"
 
 #include <algorithm>
 

@@ -31,16 +31,16 @@ namespace canfleet::transport::detail {
 ///
 /// As a PortSink it only appends to that buffer and schedules a flush for the end of the current
 /// io_context turn, so everything one broker round produced for this port goes out in one write.
-class Session final : public std::enable_shared_from_this<Session>, public broker::PortSink {
+class NodeSession final : public std::enable_shared_from_this<NodeSession>, public broker::PortSink {
  public:
-  using ClosedHandler = std::function<void(Session*)>;
+  using ClosedHandler = std::function<void(NodeSession*)>;
 
   /// `attach_counter`: the server's counter of accepted Hellos (AttachOrder); outlives the
   /// session's Hello.
-  Session(broker::Broker& broker, const ServerOptions& options, std::shared_ptr<ServerStats> stats,
-          asio::generic::stream_protocol::socket socket, std::string label, ClosedHandler on_closed,
-          std::uint64_t* attach_counter);
-  ~Session() override;
+  NodeSession(broker::Broker& broker, const BrokerServerOptions& options,
+              std::shared_ptr<BrokerServerStats> stats, asio::generic::stream_protocol::socket socket,
+              std::string label, ClosedHandler on_closed, std::uint64_t* attach_counter);
+  ~NodeSession() override;
 
   void Start();
 
@@ -51,7 +51,7 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
     kError,  ///< drop what is queued, write Error{reason}, then close
   };
   /// Ends the session once: detaches the port, then closes the socket as `farewell` says (within
-  /// ServerOptions::close_linger at most). `level` is the log level of the reason.
+  /// BrokerServerOptions::close_linger at most). `level` is the log level of the reason.
   void Close(const std::string& reason, Farewell farewell, spdlog::level::level_enum level);
 
   /// Attached to a bus and not closed.
@@ -97,8 +97,8 @@ class Session final : public std::enable_shared_from_this<Session>, public broke
   void CloseSocket();
 
   broker::Broker& broker_;
-  const ServerOptions options_;
-  std::shared_ptr<ServerStats> stats_;
+  const BrokerServerOptions options_;
+  std::shared_ptr<BrokerServerStats> stats_;
   asio::generic::stream_protocol::socket socket_;
   asio::steady_timer timer_;  ///< Hello deadline, then close linger
   std::string label_;         ///< "session 3 (quad-5 on can0, port 7, tcp 127.0.0.1:40312)"

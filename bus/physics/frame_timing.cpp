@@ -1,4 +1,4 @@
-#include "bus/frame_timing.hpp"
+#include "bus/physics/frame_timing.hpp"
 
 #include <array>
 

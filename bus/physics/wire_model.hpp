@@ -1,14 +1,23 @@
 #pragma once
-/// @file What the broker needs to know about a CAN wire beyond bus/frame_timing.hpp: who wins
-/// arbitration, how long a failed transfer occupies the bus, and how long an error-passive
-/// transmitter must wait before it may send again. All lengths are in bit times.
+/// @file The rules of a CAN wire beyond the length of a frame (frame_timing.hpp): who wins
+/// arbitration, who acknowledges, how long a failed transfer occupies the bus, what a transmitter
+/// counts for it, how long an error-passive transmitter waits, and when a bus-off controller
+/// recovers. The broker applies them to its ports (orchestrator/broker/virtual_bus.hpp); with
+/// fault_confinement.hpp (the counters of one controller) this folder is the whole physics.
+/// Lengths are in bit times.
 
 #include <cstdint>
 
 #include "bus/can_frame.hpp"
-#include "bus/frame_timing.hpp"
+#include "bus/physics/fault_confinement.hpp"
+#include "bus/physics/frame_timing.hpp"
 
-namespace canfleet::broker {
+namespace canfleet {
+
+/// The bit rates of classical CAN the model accepts (ISO 11898-2 high-speed: up to 1 Mbit/s;
+/// 10 kbit/s is the lowest rate of CiA 301's bit timing table).
+inline constexpr std::uint32_t kMinBitrate = 10'000;
+inline constexpr std::uint32_t kMaxBitrate = 1'000'000;
 
 /// The arbitration field of `frame` as a 32-bit number whose order is the wire's order: of two
 /// frames, the one with the smaller key wins arbitration (ISO 11898-1:2015 §6.3 bus access method;
@@ -34,6 +43,12 @@ constexpr std::uint32_t ArbitrationKey(const CanFrame& frame) {
     return base << 21 | 1U << 20 | 1U << 19 | extension << 1 | rtr;
   }
   return (frame.id & 0x7FFU) << 21 | rtr << 20;
+}
+
+/// Whether a controller acknowledges the frames of others: any controller that is not bus-off
+/// does, error-passive ones too (ISO 11898-1:2015 §6.10); a listen-only one never drives the bus.
+constexpr bool Acknowledges(ControllerState state, bool listen_only) {
+  return !listen_only && state != ControllerState::kBusOff;
 }
 
 /// A transfer that ends in an ACK error: the transmitter sees no dominant ACK slot and starts its
@@ -74,4 +89,24 @@ inline std::uint32_t AttemptBits(const CanFrame& frame, TransferOutcome outcome)
   return bits.total();
 }
 
-}  // namespace canfleet::broker
+/// What the transmitter of a failed transfer counts (ISO 11898-1:2015 §12.1.4.2 rule 3 and its
+/// exception 1, see FaultConfinement::OnTransmitError). Only for a failed outcome.
+constexpr TransmitError TransmitErrorOf(TransferOutcome outcome) {
+  return outcome == TransferOutcome::kAckError ? TransmitError::kAck : TransmitError::kBit;
+}
+
+/// When a transmitter in `state` whose transfer ended at `end` may start its next one: at once,
+/// or after suspend transmission when it is error-passive. Bus times.
+inline BusTime ReadyAfterTransfer(ControllerState state, BusTime end, std::uint32_t bitrate) {
+  return state == ControllerState::kErrorPassive ? end + BitTime(kSuspendTransmissionBits, bitrate) : end;
+}
+
+/// When a controller that went bus-off at `at` has seen 128 occurrences of 11 recessive bits and
+/// recovers (ISO 11898-1:2015 §12.1.4.2), counted as 1408 bit times from the end of the error
+/// frame that caused it. Simplification: on a busy bus a real controller needs longer (each frame
+/// supplies about one of the 128 occurrences).
+inline BusTime RecoveryAttemptAt(BusTime at, std::uint32_t bitrate) {
+  return at + BitTime(kBusOffRecoveryBits, bitrate);
+}
+
+}  // namespace canfleet
