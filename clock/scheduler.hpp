@@ -4,6 +4,12 @@
 /// Drivers decide what time is: SimulatedScheduler (tests advance it by hand) and AsioScheduler
 /// (real time). The seam can say "my next deadline is T" (NextDeadline) and be told "advance to T"
 /// (AdvanceTo), which is all a lock-step driver granted by the orchestrator will need.
+///
+/// Time is events (design decision 10): a periodic timer whose callback has nothing to do may be put
+/// to sleep (Timer::Sleep). The scheduler then never wakes for it, yet keeps its place: every time
+/// its deadline comes it is re-armed one period later, as a callback that only re-armed itself
+/// would have done, so a Timer::Wake puts it back exactly where it would have been (the same
+/// instants, the same order among timers due at the same instant).
 
 #include <chrono>
 #include <cstdint>
@@ -38,16 +44,21 @@ class Scheduler {
   /// the real time of the call (real-time drivers).
   virtual TimePoint Now() const = 0;
 
-  /// The earliest deadline of any armed timer.
+  /// The earliest deadline of any armed timer (sleeping timers need no wake-up: not counted).
   std::optional<TimePoint> NextDeadline() const;
 
-  /// Number of armed timers (for tests and leak checks).
+  /// Number of armed timers, sleeping ones excluded (for tests and leak checks).
   std::size_t ArmedCount() const { return heap_.size(); }
+  /// Number of sleeping periodic timers (Timer::Sleep).
+  std::size_t SleepingCount() const { return sleeping_.size(); }
+  /// Callbacks run since construction: the work the clock caused (tests count wake-ups with it).
+  std::uint64_t FiredCount() const { return fired_; }
 
  protected:
   /// Runs every timer whose deadline is at or before `limit`, earliest first (ties in arming order).
   /// `on_each` is called with each deadline before its callback runs, so a simulated driver can set
-  /// its clock. A callback may arm or cancel any timer, including itself.
+  /// its clock. A callback may arm or cancel any timer, including itself. Sleeping timers due on
+  /// the way are re-armed one period on, in their place in that order, without a callback.
   void RunDue(TimePoint limit, const std::function<void(TimePoint)>& on_each);
 
   /// Called whenever the earliest deadline may have changed (a real-time driver re-arms its OS timer).
@@ -55,15 +66,27 @@ class Scheduler {
 
  private:
   friend class Timer;
+  using Heap = std::vector<Timer*>;
   void Arm(Timer& timer, TimePoint deadline);
   void Disarm(Timer& timer);
-  bool Before(const Timer* a, const Timer* b) const;
-  void SiftUp(std::size_t i);
-  void SiftDown(std::size_t i);
-  void Swap(std::size_t i, std::size_t j);
+  void Sleep(Timer& timer, Duration period);
+  void Wake(Timer& timer);
+  /// Re-arms, without their callbacks, the sleeping timers that come before (deadline, sequence).
+  void AdvanceSleepers(TimePoint deadline, std::uint64_t sequence);
+  /// Outside RunDue: the sleeping timers due by Now() have come, before anything armed now.
+  void CatchUpSleepers();
+  static bool Before(const Timer* a, const Timer* b);
+  void Insert(Heap& heap, Timer& timer);
+  void Remove(Heap& heap, Timer& timer);
+  static void SiftUp(Heap& heap, std::size_t i);
+  static void SiftDown(Heap& heap, std::size_t i);
+  static void Swap(Heap& heap, std::size_t i, std::size_t j);
 
-  std::vector<Timer*> heap_;  // indexed binary min-heap; Timer::heap_index_ points back into it
+  Heap heap_;      // armed timers: indexed binary min-heap; Timer::heap_index_ points back into it
+  Heap sleeping_;  // sleeping timers, the same way (Timer::sleep_period_ > 0)
   std::uint64_t next_sequence_ = 0;
+  std::uint64_t fired_ = 0;
+  bool running_due_ = false;
 };
 
 /// A one-shot timer with a fixed callback, re-armable without allocation.
@@ -80,9 +103,23 @@ class Timer {
   /// Arms (or re-arms) the timer `delay` from now.
   void StartAfter(Duration delay);
   void Cancel();
-  bool Armed() const { return heap_index_ != kNotArmed; }
-  /// The last deadline the timer was armed for (still valid inside its own callback).
+  /// Armed and awake: the scheduler will run the callback at Deadline().
+  bool Armed() const { return heap_index_ != kNotArmed && !Asleep(); }
+  /// The last deadline the timer was armed for (still valid inside its own callback); for a
+  /// sleeping timer, the deadline it has reached.
   TimePoint Deadline() const { return deadline_; }
+
+  /// Puts an armed timer to sleep, as the timer of a periodic activity with nothing to do: from
+  /// now on, each time its deadline comes the scheduler re-arms it for deadline + `period` (> 0)
+  /// without running the callback and without waking up for it, exactly as a callback whose first
+  /// action re-arms it one period on and which then does nothing. Wake() puts it back in its place.
+  /// Re-arming or cancelling ends the sleep. No effect on a timer that is not armed.
+  void Sleep(Duration period);
+  /// A sleeping timer is armed again at the deadline it has reached, in the order it would have
+  /// had (so its next callback comes at the instant, and among the timers due at that instant, it
+  /// would have come if it had never slept). No effect on a timer that is not asleep.
+  void Wake();
+  bool Asleep() const { return sleep_period_ > Duration::zero(); }
 
  private:
   friend class Scheduler;
@@ -91,7 +128,8 @@ class Timer {
   std::function<void()> on_expiry_;
   TimePoint deadline_{};
   std::uint64_t sequence_ = 0;
-  std::size_t heap_index_ = kNotArmed;
+  std::size_t heap_index_ = kNotArmed;  // into Scheduler::heap_, or sleeping_ while asleep
+  Duration sleep_period_{0};            // > 0 while asleep
 };
 
 /// Simulated time for unit tests: time stands still until the test advances it.

@@ -20,30 +20,29 @@ DelayedFault::DelayedFault(Scheduler& scheduler, canopen::CanopenStack& stack, c
       behaviour_sub_(behaviour_sub),
       timer_(scheduler, [this] { Activate(); }) {}
 
-void DelayedFault::Update(bool present, Duration delay) {
+bool DelayedFault::Update(bool present, Duration delay) {
   switch (state_) {
     case State::kInactive:
-      if (!present) return;
+      if (!present) return false;
       if (delay <= Duration::zero()) {
         Activate();
       } else {
         state_ = State::kPending;
         timer_.StartAfter(delay);
       }
-      return;
+      return true;
     case State::kPending:
-      if (!present) {
-        timer_.Cancel();
-        state_ = State::kInactive;
-      }
-      return;
+      if (present) return false;
+      timer_.Cancel();
+      state_ = State::kInactive;
+      return true;
     case State::kActive:
-      if (!present) {
-        state_ = State::kInactive;
-        stack_.emcy().Clear(entry_.code, entry_.info);
-      }
-      return;
+      if (present) return false;
+      state_ = State::kInactive;
+      stack_.emcy().Clear(entry_.code, entry_.info);
+      return true;
   }
+  return false;
 }
 
 void DelayedFault::Reset() {

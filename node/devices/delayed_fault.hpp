@@ -35,8 +35,9 @@ class DelayedFault {
   DelayedFault& operator=(const DelayedFault&) = delete;
 
   /// Reports the condition as sampled now. `delay` is the channel's current error response delay;
-  /// it is loaded when the fault enters pending.
-  void Update(bool present, Duration delay);
+  /// it is loaded when the fault enters pending. Returns true if the state changed (on-demand
+  /// ticks: a fault whose condition stays as it is needs no further Update until it changes).
+  bool Update(bool present, Duration delay);
   /// Back to inactive without an EMCY: reset application (the stack already forgot its errors).
   void Reset();
 

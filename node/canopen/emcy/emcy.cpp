@@ -123,6 +123,7 @@ void Emcy::Raise(const ErrorEntry& error) {
   RecomputeRegister();
   SyncRegister();
   SyncHistory();
+  NotifyActiveChanged();
   Emit(error.code, error.msef);
 }
 
@@ -136,12 +137,14 @@ void Emcy::Clear(std::uint16_t code, std::uint16_t info, bool keep_in_history) {
   RecomputeRegister();
   SyncRegister();
   SyncHistory();
+  NotifyActiveChanged();
   // CiA 301 §7.2.7.1 error state diagram: transition 5 (all errors gone) sends 0000h with the
   // (now empty) register; transition 3 (one of several gone) may send it with what remains.
   if (active_.empty() || options_.reset_emcy_on_partial_clear) Emit(kErrorReset, {});
 }
 
 void Emcy::ClearAll() {
+  const bool had_active = !active_.empty();
   active_.clear();
   history_.clear();
   error_register_ = 0;
@@ -149,6 +152,12 @@ void Emcy::ClearAll() {
   last_transmit_.reset();
   SyncRegister();
   SyncHistory();
+  if (had_active) NotifyActiveChanged();
+}
+
+void Emcy::NotifyActiveChanged() {
+  for (auto& listener : active_listeners_)
+    listener();
 }
 
 void Emcy::ClearHistory() {

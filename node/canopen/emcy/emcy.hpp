@@ -124,6 +124,11 @@ class Emcy {
   /// Frames dropped because the inhibit queue was full.
   std::size_t Overruns() const { return overruns_; }
 
+  /// Adds a listener called whenever the set of active errors changes (Raise, Clear, ClearAll),
+  /// after 1001h and 1003h were updated: device logic that follows the fault state (the Quad's
+  /// outputs, AX020506 §4.2) wakes with it instead of polling ActiveCount().
+  void AddActiveListener(std::function<void()> listener) { active_listeners_.push_back(std::move(listener)); }
+
   /// The controller is back from bus-off: frames the port refused while bus-off (above all the
   /// 8140h "recovered from bus-off" EMCY raised at bus-off) go out now, in order, inhibit time
   /// permitting — as CANopenNode's EMCY FIFO sends them once the controller transmits again.
@@ -145,6 +150,7 @@ class Emcy {
   void LoadInhibitTime();
   void InstallHooks();
 
+  void NotifyActiveChanged();
   void PushHistory(std::uint32_t value);
   void RemoveFromHistory(std::uint32_t value);
   void RecomputeRegister();
@@ -184,6 +190,7 @@ class Emcy {
 
   std::optional<CanFrame> last_sent_;
   std::function<void(const CanFrame&)> on_sent_;
+  std::vector<std::function<void()>> active_listeners_;
   bool syncing_ = false;  // set while the service writes its own objects: its listeners ignore that
   Timer inhibit_timer_;
 };

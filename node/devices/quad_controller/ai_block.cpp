@@ -109,15 +109,19 @@ void AiBlock::Reset() {
 
 // §3.3.9: the number of pulses is sampled at the end of the measuring window, then the frequency
 // is calculated. Windows are whole milliseconds, so a 1 ms count is exact.
-void AiBlock::CountPulses() {
+bool AiBlock::CountPulses() {
+  bool changed = false;
   for (int ch = kAnalogInputs; ch < kInputs; ++ch) {
     Channel& c = channels_[ch];
     if (Type(ch) != SensorType::kFrequency || !Measures(Mode(ch))) {
+      changed = changed || c.window_start_upulses != c.phase_upulses || c.window_elapsed_ms != 0 ||
+                c.frequency_fv != 0;
       c.window_start_upulses = c.phase_upulses;
       c.window_elapsed_ms = 0;
       c.frequency_fv = 0;
       continue;
     }
+    changed = true;  // the window's millisecond count moves on
     const double hz = io_.fin_frequency[ch - kAnalogInputs]->Number();
     c.phase_upulses += static_cast<std::uint64_t>(std::llround(hz * 1000.0));  // µpulses per ms
     ++c.window_elapsed_ms;
@@ -129,6 +133,14 @@ void AiBlock::CountPulses() {
     c.window_start_upulses = c.phase_upulses;
     c.window_elapsed_ms = 0;
   }
+  return changed;
+}
+
+bool AiBlock::Counting() const {
+  for (int ch = kAnalogInputs; ch < kInputs; ++ch) {
+    if (Type(ch) == SensorType::kFrequency && Measures(Mode(ch))) return true;
+  }
+  return false;
 }
 
 int AiBlock::Measure(int ch) const {
@@ -194,11 +206,13 @@ void AiBlock::WriteProcessValue(int ch, double pv) {
   refs_[ch].pv.Set(std::clamp<long long>(std::llround(pv), -32768, 32767));
 }
 
-void AiBlock::Sample() {
+bool AiBlock::Sample() {
   const auto enabled = error_check_enable_.Get();
+  bool changed = false;
   for (int ch = 0; ch < kInputs; ++ch) {
     Refs& r = refs_[ch];
     Channel& c = channels_[ch];
+    const auto before = c.State();
     const auto type = static_cast<std::uint16_t>(r.type.Get());
     const auto mode = static_cast<std::uint8_t>(r.mode.Get());
     if (type != c.last_type || mode != c.last_mode) {
@@ -226,7 +240,9 @@ void AiBlock::Sample() {
     const Duration delay = std::chrono::milliseconds(r.error_delay.Get());
     c.low->Update(check && c.fv < r.error_min.Get(), delay);
     c.high->Update(check && c.fv > r.error_max.Get(), delay);
+    changed = changed || c.State() != before;
   }
+  return changed;
 }
 
 void AiBlock::Autozero(int ch) {

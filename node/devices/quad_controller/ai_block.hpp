@@ -23,6 +23,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <tuple>
 
 #include "clock/scheduler.hpp"
 #include "node/canopen/stack/canopen_stack.hpp"
@@ -39,10 +40,14 @@ class AiBlock {
   AiBlock(const AiBlock&) = delete;
   AiBlock& operator=(const AiBlock&) = delete;
 
-  /// Counts pulses of frequency inputs; call every millisecond.
-  void CountPulses();
-  /// Samples every input; call every 10 ms.
-  void Sample();
+  /// Counts pulses of frequency inputs; call every millisecond. Returns true if anything changed
+  /// (always, while a measuring window runs).
+  bool CountPulses();
+  /// Samples every input; call every 10 ms. Returns true if anything changed (a filter still
+  /// settling or a repeating average counting changes something at every sample).
+  bool Sample();
+  /// A frequency input is measuring: its window runs every millisecond, whatever the inputs.
+  bool Counting() const;
   /// Reset application: filters, windows, thresholds and faults start over.
   void Reset();
 
@@ -73,6 +78,12 @@ class AiBlock {
     int window_elapsed_ms = 0;
     int frequency_fv = 0;
     std::unique_ptr<DelayedFault> low, high;
+
+    /// Everything a tick may change (on-demand ticks compare it before and after a tick).
+    auto State() const {
+      return std::tuple(fv, on, filtered, filter_started, sum, count, last_type, last_mode, phase_upulses,
+                        window_start_upulses, window_elapsed_ms, frequency_fv, low->state(), high->state());
+    }
   };
 
   int Measure(int ch) const;

@@ -135,15 +135,18 @@ void AoBlock::Publish(int n) {
   r.measured.Set(std::lround(current));
 }
 
-void AoBlock::Update(const OutputConditions& conditions, const AiBlock& ai) {
+bool AoBlock::Update(const OutputConditions& conditions, const AiBlock& ai) {
+  bool changed = false;
   for (int n = 0; n < kPouts; ++n) {
     Refs& r = refs_[n];
     Output& o = outputs_[n];
+    const double before = o.present;
     ApplyReceivedPv(n);
     const bool current_mode = r.output_type.Get() == static_cast<std::int64_t>(OutputType::kCurrent);
     if (!current_mode) {
       o.present = 0;
-      o.faults->Update(false, *io_.pout_load[n], Duration::zero());
+      changed =
+          o.faults->Update(false, *io_.pout_load[n], Duration::zero()) || changed || o.present != before;
       continue;
     }
     const bool can = r.control.Get() == kControlCan;
@@ -165,8 +168,10 @@ void AoBlock::Update(const OutputConditions& conditions, const AiBlock& ai) {
         o.present = target;
     }
     Publish(n);
-    o.faults->Update(true, *io_.pout_load[n], std::chrono::milliseconds(r.error_delay.Get()));
+    changed = o.faults->Update(true, *io_.pout_load[n], std::chrono::milliseconds(r.error_delay.Get())) ||
+              changed || o.present != before;
   }
+  return changed;
 }
 
 }  // namespace canfleet::devices::quad

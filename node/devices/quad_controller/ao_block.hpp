@@ -39,8 +39,9 @@ class AoBlock {
   AoBlock(const AoBlock&) = delete;
   AoBlock& operator=(const AoBlock&) = delete;
 
-  /// One millisecond of the output stage.
-  void Update(const OutputConditions& conditions, const AiBlock& ai);
+  /// One millisecond of the output stage. Returns true if the block's state changed (a ramp
+  /// moving, a load fault); outputs and objects it moves wake the ticks through their listeners.
+  bool Update(const OutputConditions& conditions, const AiBlock& ai);
   void Reset();
 
  private:

@@ -9,7 +9,7 @@ DiBlock::DiBlock(canopen::CanopenStack& stack, const QuadIo& io)
       polarity_(stack.od(), kDiPolarity, 1),
       read_state_(stack.od(), kDiReadState, 1) {}
 
-void DiBlock::Sample(const AiBlock& ai) {
+bool DiBlock::Sample(const AiBlock& ai) {
   std::uint8_t bits = 0;
   for (int ch = 0; ch < kInputs; ++ch) {
     bool on = false;
@@ -31,8 +31,10 @@ void DiBlock::Sample(const AiBlock& ai) {
     }
     if (on) bits = static_cast<std::uint8_t>(bits | (1u << ch));
   }
+  const bool changed = bits != state_;
   state_ = bits;
   if (read_state_.Set(bits)) stack_.pdo().NotifyChanged(read_state_.sub());
+  return changed;
 }
 
 }  // namespace canfleet::devices::quad

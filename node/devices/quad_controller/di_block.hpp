@@ -22,7 +22,8 @@ class DiBlock {
  public:
   DiBlock(canopen::CanopenStack& stack, const QuadIo& io);
 
-  void Sample(const AiBlock& ai);
+  /// Returns true if 6000h changed.
+  bool Sample(const AiBlock& ai);
   /// Bit `ch` of 6000h.
   bool State(int ch) const { return ((state_ >> ch) & 1) != 0; }
 

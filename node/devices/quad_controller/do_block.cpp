@@ -51,7 +51,10 @@ bool DoBlock::Control(int output, const AiBlock& ai, const DiBlock& di) const {
   return false;
 }
 
-void DoBlock::Update(const OutputConditions& conditions, const AiBlock& ai, const DiBlock& di) {
+bool DoBlock::Update(const OutputConditions& conditions, const AiBlock& ai, const DiBlock& di) {
+  const auto previous_control = previous_control_;
+  const auto latch = latch_;
+  bool faults_changed = false;
   std::uint8_t states = 0;
   for (int o = 0; o < kDigitalOutputs; ++o) {
     const auto bit = static_cast<unsigned>(o);
@@ -63,7 +66,7 @@ void DoBlock::Update(const OutputConditions& conditions, const AiBlock& ai, cons
     previous_control_[o] = control;
     if (!digital) {
       latch_[o] = false;
-      pout_faults_[o]->Update(false, *io_.pout_load[o], Duration::zero());
+      faults_changed = pout_faults_[o]->Update(false, *io_.pout_load[o], Duration::zero()) || faults_changed;
       continue;
     }
     bool logic;
@@ -85,11 +88,12 @@ void DoBlock::Update(const OutputConditions& conditions, const AiBlock& ai, cons
 
     const Duration delay = std::chrono::milliseconds(error_delay_[o].Get());
     if (is_pout)
-      pout_faults_[o]->Update(true, *io_.pout_load[o], delay);
+      faults_changed = pout_faults_[o]->Update(true, *io_.pout_load[o], delay) || faults_changed;
     else
-      dout_fault_->Update(!io_.dout_load->Is(kLoadNominal), delay);
+      faults_changed = dout_fault_->Update(!io_.dout_load->Is(kLoadNominal), delay) || faults_changed;
   }
   if (read_state_.Set(states)) stack_.pdo().NotifyChanged(read_state_.sub());
+  return faults_changed || previous_control != previous_control_ || latch != latch_;
 }
 
 // The load decides what flows: a short trips the driver's protection, an open load draws nothing.

@@ -35,7 +35,9 @@ class DoBlock {
   DoBlock(const DoBlock&) = delete;
   DoBlock& operator=(const DoBlock&) = delete;
 
-  void Update(const OutputConditions& conditions, const AiBlock& ai, const DiBlock& di);
+  /// One millisecond of the output stage. Returns true if the block's state changed (edges,
+  /// latches, load faults); outputs and objects it moves wake the ticks through their listeners.
+  bool Update(const OutputConditions& conditions, const AiBlock& ai, const DiBlock& di);
   void Reset();
 
   /// POUT `n` (0-3) is in digital mode (6310h = 1000).

@@ -10,9 +10,10 @@ LoadFaults::LoadFaults(Scheduler& scheduler, canopen::CanopenStack& stack, std::
     : short_(scheduler, stack, MakeErrorEntry(kEmcyShortCircuit, description, channel), behaviour_sub),
       open_(scheduler, stack, MakeErrorEntry(kEmcyOpenCircuit, description, channel), behaviour_sub) {}
 
-void LoadFaults::Update(bool monitored, const IoSignal& load, Duration delay) {
-  short_.Update(monitored && load.Is(kLoadShort), delay);
-  open_.Update(monitored && load.Is(kLoadOpen), delay);
+bool LoadFaults::Update(bool monitored, const IoSignal& load, Duration delay) {
+  const bool short_changed = short_.Update(monitored && load.Is(kLoadShort), delay);
+  const bool open_changed = open_.Update(monitored && load.Is(kLoadOpen), delay);
+  return short_changed || open_changed;
 }
 
 void LoadFaults::Reset() {

@@ -20,8 +20,9 @@ class LoadFaults {
   LoadFaults(Scheduler& scheduler, canopen::CanopenStack& stack, std::uint8_t description,
              std::uint8_t channel, std::uint8_t behaviour_sub);
 
-  /// `monitored` false clears both (the output is in the other block's mode).
-  void Update(bool monitored, const IoSignal& load, Duration delay);
+  /// `monitored` false clears both (the output is in the other block's mode). Returns true if
+  /// either fault changed state.
+  bool Update(bool monitored, const IoSignal& load, Duration delay);
   void Reset();
 
  private:

@@ -4,6 +4,7 @@
 #include "node/devices/quad_controller/quad_error_policy.hpp"
 #include "node/devices/quad_controller/quad_objects.hpp"
 #include "node/devices/quad_controller/quad_validators.hpp"
+#include "node/devices/wake_on_change.hpp"
 
 namespace canfleet::devices {
 
@@ -27,6 +28,8 @@ void QuadController::ConfigureStack(std::size_t port, StackSetup& setup) {
   // §3.1.10: 5555h TRUE boots straight into operational.
   setup.options.start_operational = [this] { return od_->GetUnsigned(quad::kStartInOperational, 0) != 0; };
   setup.hooks.on_reset_application = [this] { OnResetApplication(); };
+  // §4.2: the outputs follow the NMT state.
+  setup.hooks.on_state_changed = [this](canopen::NmtState) { WakeTicks(); };
 }
 
 void QuadController::Attach(DeviceContext& context) {
@@ -60,26 +63,42 @@ void QuadController::Attach(DeviceContext& context) {
     return false;
   });
   // Armed in this order, the 10 ms sample runs before the 1 ms output tick due at the same time.
-  sample_tick_ = std::make_unique<PeriodicTick>(context.scheduler, kSamplePeriod, [this] { OnSample(); });
-  output_tick_ = std::make_unique<PeriodicTick>(context.scheduler, kOutputPeriod, [this] { OnOutputTick(); });
+  // Both sleep after a tick that changed nothing, until something they read changes; a frequency
+  // input's measuring window keeps both running (it moves every millisecond; the sample reads it).
+  sample_tick_ = std::make_unique<PeriodicTick>(
+      context.scheduler, kSamplePeriod, [this] { OnSample(); },
+      [this] { return !sample_changed_ && !ai_->Counting(); });
+  output_tick_ = std::make_unique<PeriodicTick>(
+      context.scheduler, kOutputPeriod, [this] { OnOutputTick(); }, [this] { return !output_changed_; });
+  WakeOnChanges(*stack_, io_, [this] { WakeTicks(); });
   sample_tick_->Start();
   output_tick_->Start();
 }
 
 void QuadController::OnSample() {
-  ai_->Sample();
-  di_->Sample(*ai_);
+  const bool ai_changed = ai_->Sample();
+  const bool di_changed = di_->Sample(*ai_);
+  sample_changed_ = ai_changed || di_changed;
+  // The output stage reads what the sample produced (field values, ON/OFF states, 6000h).
+  if (sample_changed_) output_tick_->Wake();
 }
 
 void QuadController::OnOutputTick() {
-  ai_->CountPulses();
+  const bool pulses_changed = ai_->CountPulses();
   quad::OutputConditions conditions;
   conditions.nmt = stack_->State();
   conditions.fault_state = stack_->emcy().ActiveCount() > 0;
   conditions.fault_entered = conditions.fault_state && !fault_state_;
+  const bool fault_changed = fault_state_ != conditions.fault_state;
   fault_state_ = conditions.fault_state;
-  do_->Update(conditions, *ai_, *di_);
-  ao_->Update(conditions, *ai_);
+  const bool do_changed = do_->Update(conditions, *ai_, *di_);
+  const bool ao_changed = ao_->Update(conditions, *ai_);
+  output_changed_ = pulses_changed || fault_changed || do_changed || ao_changed;
+}
+
+void QuadController::WakeTicks() {
+  if (sample_tick_) sample_tick_->Wake();
+  if (output_tick_) output_tick_->Wake();
 }
 
 // §4.2: "Upon reset of the controller, all possible faults ... are in the inactive state." The
@@ -89,6 +108,7 @@ void QuadController::OnResetApplication() {
   if (ai_) ai_->Reset();
   if (do_) do_->Reset();
   if (ao_) ao_->Reset();
+  WakeTicks();
 }
 
 }  // namespace canfleet::devices

@@ -7,7 +7,10 @@
 /// README.md in this folder lists where the manual contradicts itself and what was chosen.
 ///
 /// Timing: inputs are sampled every 10 ms (§2.3, Appendix A); the output stage (ramps, frequency
-/// counting, fault reactions) runs every 1 ms.
+/// counting, fault reactions) runs every 1 ms. Both ticks run on demand (periodic_tick.hpp): with
+/// steady inputs and nothing in progress they sleep, and an input set, an object written, an NMT
+/// state change or an error raised or cleared wakes them at their next instant on the 10 ms / 1 ms
+/// grid, so the outputs change at exactly the instants they would with fixed ticks.
 
 #include <memory>
 #include <string_view>
@@ -48,6 +51,7 @@ class QuadController final : public Device {
   void OnSample();
   void OnOutputTick();
   void OnResetApplication();
+  void WakeTicks();
 
   DeviceOptions options_;
   quad::QuadIo signals_;
@@ -60,6 +64,9 @@ class QuadController final : public Device {
   std::unique_ptr<PeriodicTick> sample_tick_;
   std::unique_ptr<PeriodicTick> output_tick_;
   bool fault_state_ = false;
+  /// The last tick changed the blocks' state: the next one may change more (on-demand ticks).
+  bool sample_changed_ = false;
+  bool output_changed_ = false;
 };
 
 }  // namespace canfleet::devices
