@@ -5,9 +5,16 @@
 #include <stdexcept>
 #include <vector>
 
+#include "node/devices/datalogger_tc_analog/datalogger.hpp"
+#include "node/devices/datalogger_tc_analog/datalogger_io.hpp"
 #include "node/devices/eds_dictionary.hpp"
+#include "node/devices/encoder_dual_valve/encoder_io.hpp"
+#include "node/devices/encoder_dual_valve/encoder_valve_controller.hpp"
 #include "node/devices/generic_device.hpp"
+#include "node/devices/power_supply_24v_350w/power_supply.hpp"
 #include "node/devices/quad_controller/quad_controller.hpp"
+#include "node/devices/valve_12in12out/valve_controller.hpp"
+#include "node/devices/valve_12in12out/valve_io.hpp"
 
 namespace canfleet::devices {
 namespace {
@@ -20,7 +27,7 @@ std::unique_ptr<Device> Create(const DeviceOptions& options) {
 }  // namespace
 
 std::span<const DeviceInfo> Devices() {
-  static const std::array<DeviceInfo, 1> devices = {{
+  static const std::array<DeviceInfo, 5> devices = {{
       {.name = QuadController::kName,
        .summary = QuadController::kSummary,
        .ports = 1,
@@ -33,6 +40,43 @@ std::span<const DeviceInfo> Devices() {
        .eds_text = QuadControllerEdsText,
        .declare_signals = [](SimulatedIo& io) { quad::QuadIo declared(io); },
        .create = Create<QuadController>},
+      {.name = ValveController::kName,
+       .summary = ValveController::kSummary,
+       .ports = 1,
+       .factory_node_id = 127,  // UMAX020411A §3.1: node-ID 127, 125 kbit/s
+       .factory_bit_rate_kbit = 125,
+       .eds_file_name = "valve-12in12out.eds",
+       .eds_text = ValveEdsText,
+       .declare_signals = [](SimulatedIo& io) { valve::DeclareValveSignals(io); },
+       .create = Create<ValveController>},
+      {.name = EncoderValveController::kName,
+       .summary = EncoderValveController::kSummary,
+       .ports = 1,
+       .factory_node_id = 127,  // AX023241 chapter 3 §1.1: node-ID 127, 125 kbit/s
+       .factory_bit_rate_kbit = 125,
+       .eds_file_name = "encoder-dual-valve.eds",
+       .eds_text = EncoderEdsText,
+       .declare_signals = [](SimulatedIo& io) { encoder::DeclareEncoderSignals(io); },
+       .create = Create<EncoderValveController>},
+      {.name = DataLogger::kName,
+       .summary = DataLogger::kSummary,
+       .ports = 2,
+       // UMAX181001 §3.1: one factory node-ID and bit rate, the same on both ports (separate buses).
+       .factory_node_id = 127,
+       .factory_bit_rate_kbit = 125,
+       .eds_file_name = "datalogger-tc-analog.eds",
+       .eds_text = DataLoggerEdsText,
+       .declare_signals = datalogger::DeclareDataLoggerSignals,
+       .create = Create<DataLogger>},
+      {.name = PowerSupply::kName,
+       .summary = PowerSupply::kSummary,
+       .ports = 1,
+       .factory_node_id = PowerSupply::kFactoryNodeId,  // UMAX080311 §2.1
+       .factory_bit_rate_kbit = PowerSupply::kFactoryBitRateKbit,
+       .eds_file_name = PowerSupply::kEdsFileName,
+       .eds_text = PowerSupplyEdsText,
+       .declare_signals = PowerSupply::DeclareSignals,
+       .create = Create<PowerSupply>},
   }};
   return devices;
 }

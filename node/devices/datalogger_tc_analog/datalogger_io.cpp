@@ -1,0 +1,47 @@
+#include "node/devices/datalogger_tc_analog/datalogger_io.hpp"
+
+#include <string>
+#include <vector>
+
+namespace canfleet::devices::datalogger {
+
+DataLoggerIo::DataLoggerIo(SimulatedIo& sim) : io(sim) {
+  for (int i = 0; i < kThermocouples; ++i) {
+    const std::string ch = "TC" + std::to_string(i + 1);
+    // The widest table range of the eight types (IEC 60584-1: type K/E/T from -270 C, B to 1820 C).
+    tc_temperature[i] = &io.AddInput(
+        NumberSpec(ch + ".temperature_C", "C", -270, 1820, 25, "hot-junction temperature of " + ch));
+    tc_open[i] = &io.AddInput(BoolSpec(ch + ".open", false, ch + " open circuit (broken or unplugged)"));
+  }
+  cold_junction = &io.AddInput(
+      NumberSpec("CJ.temperature_C", "C", -40, 125, 25, "cold-junction sensor at the TC connectors"));
+  const std::vector<std::string> levels = {kLevelOpen, kLevelHigh, kLevelLow};
+  for (int i = 0; i < kAnalogInputs; ++i) {
+    const int n = i + 1;
+    const std::string ch = "AIN" + std::to_string(n);
+    // 0..36 V: a 24 V system's voltage on a voltage input; 40 mA: far past the 0-20 mA range.
+    ain_voltage[i] = &io.AddInput(NumberSpec(ch + ".voltage_mV", "mV", 0, 36000, 2500, "voltage at " + ch));
+    ain_current[i] =
+        &io.AddInput(NumberSpec(ch + ".current_uA", "uA", 0, 40000, 12000, "current into " + ch));
+    if (n >= kFirstPulseInput && n < kFirstPulseInput + kPulseInputs) {
+      const std::size_t p = static_cast<std::size_t>(n - kFirstPulseInput);
+      ain_frequency[p] =
+          &io.AddInput(NumberSpec(ch + ".frequency_Hz", "Hz", 0, 50000, 1000, "signal frequency at " + ch));
+      ain_duty[p] = &io.AddInput(NumberSpec(ch + ".duty_pct", "%", 0, 100, 50, "PWM duty cycle at " + ch));
+    }
+  }
+  for (int n = kFirstUniversal; n <= kAnalogInputs; ++n) {
+    const std::string ch = "DIN" + std::to_string(n);
+    din_level[static_cast<std::size_t>(n - kFirstUniversal)] = &io.AddInput(EnumSpec(
+        ch + ".level", levels, kLevelOpen, "input " + std::to_string(n) + " pin: floating, high or low"));
+  }
+  supply = &io.AddInput(NumberSpec("VPS.voltage_V", "V", 0, 70, 24, "supply voltage"));
+  cpu_temperature =
+      &io.AddInput(NumberSpec("TEMP.temperature_C", "C", -50, 150, 35, "processor temperature"));
+}
+
+void DeclareDataLoggerSignals(SimulatedIo& io) {
+  DataLoggerIo declared(io);
+}
+
+}  // namespace canfleet::devices::datalogger
