@@ -27,6 +27,15 @@ function(canfleet_unit_test name)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
 endfunction()
 
+# canfleet_integration_test(<name> SOURCES ... DEPS ...): real sockets, real time, another program
+# (tests/integration/CMakeLists.txt says what belongs there). Label "integration", generous timeout.
+function(canfleet_integration_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main canfleet_warnings)
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS integration TIMEOUT 300)
+endfunction()
+
 if(CANFLEET_FUZZ)
   # Instrument all our libraries for coverage so libFuzzer can see inside them.
   add_compile_options(-fsanitize=fuzzer-no-link,address,undefined)

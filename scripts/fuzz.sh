@@ -1,33 +1,168 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets with clang and runs each for a short time (default 15 s each).
-# Usage: scripts/fuzz.sh [seconds-per-target]
+# Builds the libFuzzer targets with clang, optimised and with ASan+UBSan, and runs each in turn.
+#
+#   scripts/fuzz.sh [SECONDS]                   every target for SECONDS (default 15): CI's smoke run
+#   scripts/fuzz.sh --minutes N [TARGET...]     long mode: N minutes per target (default: all), then
+#                                               the figures go into fuzz/README.md and the minimised
+#                                               corpus into fuzz/corpus/<target>/
+#
+# Where inputs live (see fuzz/README.md):
+#   fuzz/seeds/<target>/    hand-written seeds, each one a case someone meant
+#   fuzz/corpus/<target>/   the minimised corpus in the repository: what long runs found beyond the
+#                           seeds, so a fresh clone starts deep
+#   $CANFLEET_FUZZ_CACHE/<target>/   the growing corpus, kept across runs outside the clone as
+#                           ccache keeps its cache; default ${XDG_CACHE_HOME:-$HOME/.cache}/canfleet-fuzz.
+#                           <target>.executions there sums the executions of every run.
+# Environment: FUZZ_JOBS (build jobs, default nproc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # CI builds a fresh clone in a new folder each time: relative paths let ccache hit across clones.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
-seconds=${1:-15}
 
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCANFLEET_FUZZ=ON \
-  -DCANFLEET_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
-cmake --build build-fuzz -j "$(nproc)"
+seconds=15
+minutes=""
+only=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --minutes)
+      minutes=${2:?--minutes needs a number}
+      shift 2
+      ;;
+    --help | -h)
+      sed -n '2,17p' "$0"
+      exit 0
+      ;;
+    [0-9]*)
+      seconds=$1
+      shift
+      ;;
+    *)
+      only+=("$1")
+      shift
+      ;;
+  esac
+done
+[ -n "$minutes" ] && seconds=$((minutes * 60))
 
-shopt -s nullglob
-targets=(build-fuzz/fuzz/fuzz_*)
-if [ ${#targets[@]} -eq 0 ]; then
-  echo "fuzz: no targets built"
-  exit 1
+cache=${CANFLEET_FUZZ_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/canfleet-fuzz}
+mkdir -p "$cache"
+
+# Every target registers itself in fuzz/targets/<name>.cmake.
+names=()
+for f in fuzz/targets/*.cmake; do
+  names+=("$(basename "$f" .cmake)")
+done
+if [ ${#only[@]} -gt 0 ]; then
+  for n in "${only[@]}"; do
+    [ -f "fuzz/targets/$n.cmake" ] || {
+      echo "fuzz: no target $n (fuzz/targets/$n.cmake)" >&2
+      exit 2
+    }
+  done
+  names=("${only[@]}")
 fi
-for t in "${targets[@]}"; do
-  name=$(basename "$t")
-  corpus=build-fuzz/corpus/$name
+
+# -O2 with the sanitizers: an -O0 build ran ten times fewer inputs in the same time. No NDEBUG:
+# assertions stay on. Frame pointers and line tables keep the sanitizers' reports readable.
+flags="-O2 -gline-tables-only -fno-omit-frame-pointer"
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="$flags" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$flags" \
+  -DCANFLEET_FUZZ=ON -DCANFLEET_BUILD_TESTS=OFF \
+  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache >/dev/null
+cmake --build build-fuzz -j "${FUZZ_JOBS:-$(nproc)}" --target "${names[@]/#/fuzz_}"
+
+figures=build-fuzz/figures.tsv
+: >"$figures"
+failed=()
+for name in "${names[@]}"; do
+  bin=build-fuzz/fuzz/fuzz_$name
+  corpus=$cache/$name
   mkdir -p "$corpus"
-  seeds=fuzz/seeds/${name#fuzz_}
   dirs=("$corpus")
-  [ -d "$seeds" ] && dirs+=("$seeds")
-  echo "fuzz: $name for ${seconds}s"
-  "$t" -max_total_time="$seconds" -print_final_stats=1 "${dirs[@]}" 2>"build-fuzz/$name.log" || {
-    tail -40 "build-fuzz/$name.log"
+  for d in "fuzz/corpus/$name" "fuzz/seeds/$name"; do
+    [ -d "$d" ] && dirs+=("$d")
+  done
+  log=build-fuzz/fuzz_$name.log
+  echo "fuzz: $name for ${seconds}s (corpus $corpus)"
+  # -timeout: an input that runs 25 s is a hang (the slowest seed takes well under a second).
+  if ! "$bin" -max_total_time="$seconds" -timeout=25 -print_final_stats=1 "${dirs[@]}" 2>"$log"; then
+    tail -60 "$log"
+    echo "fuzz: $name FAILED; the input is in the file named above (artifact_prefix: the working folder)"
+    failed+=("$name")
+    [ -n "$minutes" ] && continue # the long mode still runs the other targets
+    exit 1
+  fi
+  executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  # The last status line: "#123 DONE cov: 1234 ft: 5678 corp: 321/45Kb ...".
+  status=$(grep -E '^#[0-9]+.*cov: ' "$log" | tail -1 || true)
+  cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")
+  ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")
+  files=$(find "$corpus" -type f | wc -l)
+  total=$(($(cat "$cache/$name.executions" 2>/dev/null || echo 0) + ${executions:-0}))
+  echo "$total" >"$cache/$name.executions"
+  echo "fuzz: $name executions ${executions:-?} (in total $total), coverage ${cov:-?} edges, ${ft:-?} features, corpus $files files"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "${executions:-0}" "$total" "${cov:-0}" "${ft:-0}" "$files" >>"$figures"
+done
+
+[ -n "$minutes" ] || exit 0
+
+# Long mode: the repository's minimised corpus. Merging into a folder that already holds the seeds
+# keeps only inputs that add coverage beyond them; the seeds' copies are then removed again.
+for name in "${names[@]}"; do
+  case " ${failed[*]} " in *" $name "*) continue ;; esac # a failed target's corpus waits for its fix
+  bin=build-fuzz/fuzz/fuzz_$name
+  work=build-fuzz/merge/$name
+  rm -rf "$work"
+  mkdir -p "$work"
+  [ -d "fuzz/seeds/$name" ] && cp "fuzz/seeds/$name"/* "$work"/
+  from=("$cache/$name")
+  [ -d "fuzz/corpus/$name" ] && from+=("fuzz/corpus/$name")
+  "$bin" -merge=1 -timeout=25 "$work" "${from[@]}" 2>"build-fuzz/merge_$name.log" || {
+    tail -30 "build-fuzz/merge_$name.log"
     exit 1
   }
-  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "build-fuzz/$name.log" | sed "s/^/fuzz: $name /"
+  if [ -d "fuzz/seeds/$name" ]; then
+    for s in "fuzz/seeds/$name"/*; do
+      rm -f "$work/$(basename "$s")"
+    done
+  fi
+  rm -rf "fuzz/corpus/$name"
+  mkdir -p "fuzz/corpus/$name"
+  find "$work" -type f -exec cp {} "fuzz/corpus/$name/" \;
+  kept=$(find "fuzz/corpus/$name" -type f | wc -l)
+  size=$(du -sk "fuzz/corpus/$name" | cut -f1)
+  echo "fuzz: $name minimised corpus: $kept files, ${size} KiB in fuzz/corpus/$name"
+  sed -i "s|^$name\t.*|&\t$kept|" "$figures"
 done
+
+# The table in fuzz/README.md: a row per target, replaced for the targets of this run.
+python3 - "$figures" "$minutes" <<'EOF'
+import datetime
+import re
+import sys
+
+figures_path, minutes = sys.argv[1], sys.argv[2]
+readme_path = "fuzz/README.md"
+start, end = "<!-- fuzz-figures:start -->", "<!-- fuzz-figures:end -->"
+text = open(readme_path).read()
+head, rest = text.split(start, 1)
+table, tail = rest.split(end, 1)
+rows = {}
+for line in table.splitlines():
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    if len(cells) == 9 and cells[0] not in ("target", "") and not set(cells[0]) <= set("-"):
+        rows[cells[0]] = cells
+today = datetime.date.today().isoformat()
+for line in open(figures_path):
+    name, runs, total, cov, ft, files, kept = line.rstrip("\n").split("\t")
+    rows[name] = [name, f"{int(runs):,}", f"{int(total):,}", cov, ft, files, kept, f"{minutes} min", today]
+header = ("| target | executions (this run) | executions (in total) | coverage (edges) | features"
+          " | corpus (files) | fuzz/corpus (files) | run | date |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n")
+body = "".join("| " + " | ".join(rows[k]) + " |\n" for k in sorted(rows))
+open(readme_path, "w").write(head + start + "\n" + header + body + end + tail)
+EOF
+echo "fuzz: figures written to fuzz/README.md"
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: FAILED: ${failed[*]} (their figures and corpus are not written)"
+  exit 1
+fi

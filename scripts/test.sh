@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test command: installs what it needs, configures, builds and runs every test.
 #   scripts/test.sh              full build + every test (unit, system, fuzz smoke)
-#   scripts/test.sh --sanitize   ASan+UBSan build, unit tests only
+#   scripts/test.sh --sanitize   ASan+UBSan build, unit and integration tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # CI builds a fresh clone in a new folder each time: relative paths let ccache hit across clones.
@@ -19,7 +19,7 @@ if [ "$mode" = sanitize ]; then
   cmake -S . -B build-asan "${common[@]}" -DCMAKE_BUILD_TYPE=Debug -DCANFLEET_SANITIZE=ON >/dev/null
   cmake --build build-asan -j "$jobs"
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-  ctest --test-dir build-asan -L unit -j "$jobs" --output-on-failure
+  ctest --test-dir build-asan -L 'unit|integration' -j "$jobs" --output-on-failure
   exit 0
 fi
 

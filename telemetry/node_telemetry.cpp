@@ -81,7 +81,7 @@ struct NodeTelemetry::Impl {
   bool has_io() const { return !options.inputs.empty() || !options.outputs.empty(); }
 
   const NodeTelemetryOptions options;
-  const Clock::time_point started = Clock::now();
+  TimePoint started{};  ///< the loop's time when the publisher was made (uptime)
 
   // DDS entities; the participant deletes the topics.
   Topic<canfleet_telemetry_NodeStatus> status_topic;
@@ -104,13 +104,13 @@ struct NodeTelemetry::Impl {
   NodeStatusSnapshot current_status;
   NodeStatusSnapshot published_status;
   bool status_change = true;  // the first publication goes out at once
-  Clock::time_point status_written{};
-  Clock::time_point status_due{};
+  TimePoint status_written{};
+  TimePoint status_due{};
   IoValues current_io;
   IoValues published_io;
   bool io_change = true;
-  Clock::time_point io_written{};
-  Clock::time_point io_due{};
+  TimePoint io_written{};
+  TimePoint io_due{};
   std::vector<EmcyInfo> emcy_batch;
   std::optional<EmcyInfo> last_emcy;
 
@@ -140,7 +140,7 @@ struct NodeTelemetry::Impl {
     Count(emcy_writer.Write(emcy), event_writes);
   }
 
-  void WriteStatus(Clock::time_point now) {
+  void WriteStatus(TimePoint now) {
     const NodeStatusSnapshot& s = current_status;
     status.nmt_state = ToDds(std::optional<NmtState>(s.nmt_state));
     status.error_register = s.error_register;
@@ -180,12 +180,23 @@ struct NodeTelemetry::Impl {
 
 NodeTelemetry::NodeTelemetry(const Participant& participant, NodeTelemetryOptions options)
     : PublisherLoop(options.min_interval) {
+  Init(participant, std::move(options));
+}
+
+NodeTelemetry::NodeTelemetry(const Participant& participant, NodeTelemetryOptions options,
+                             Scheduler& scheduler)
+    : PublisherLoop(options.min_interval, scheduler) {
+  Init(participant, std::move(options));
+}
+
+void NodeTelemetry::Init(const Participant& participant, NodeTelemetryOptions options) {
   CheckBusName(options.bus);
   if (options.inputs.size() > kMaxIoChannels || options.outputs.size() > kMaxIoChannels) {
     throw std::invalid_argument("at most " + std::to_string(kMaxIoChannels) + " inputs and outputs");
   }
   if (options.period <= std::chrono::milliseconds::zero()) throw std::invalid_argument("period must be > 0");
   impl_ = std::make_unique<Impl>(participant, std::move(options));
+  impl_->started = Now();
   Start();
 }
 
@@ -256,7 +267,7 @@ void NodeTelemetry::ConsumeLocked(bool inputs) {
   }
 }
 
-PublisherLoop::Clock::time_point NodeTelemetry::Publish(Clock::time_point now, bool force) {
+TimePoint NodeTelemetry::Publish(TimePoint now, bool force) {
   Impl& m = *impl_;
   for (const EmcyInfo& e : m.emcy_batch) {
     m.WriteEmcy(e);
@@ -279,7 +290,7 @@ PublisherLoop::Clock::time_point NodeTelemetry::Publish(Clock::time_point now, b
     m.status_written = now;
     m.status_due = now + m.options.period;
   }
-  Clock::time_point next = m.status_due;
+  TimePoint next = m.status_due;
   if (m.status_change) next = std::min(next, m.status_written + min_interval());
 
   if (m.has_io()) {

@@ -80,6 +80,9 @@ class NodeTelemetry final : private PublisherLoop {
   /// Throws std::invalid_argument for a bus name or I/O list beyond the IDL bounds.
   /// @param participant must outlive this object.
   NodeTelemetry(const Participant& participant, NodeTelemetryOptions options);
+  /// The same on simulated time (tests): no thread; publication runs on `scheduler`'s timers, from
+  /// the thread that advances it, which is also the only thread that may call the methods below.
+  NodeTelemetry(const Participant& participant, NodeTelemetryOptions options, Scheduler& scheduler);
   /// Writes any pending change, stops the thread, deletes the writers (which disposes the node's
   /// instances: monitors see it leave).
   ~NodeTelemetry();
@@ -99,8 +102,9 @@ class NodeTelemetry final : private PublisherLoop {
 
  private:
   struct Impl;
+  void Init(const Participant& participant, NodeTelemetryOptions options);
   void ConsumeLocked(bool inputs) override;
-  Clock::time_point Publish(Clock::time_point now, bool force) override;
+  TimePoint Publish(TimePoint now, bool force) override;
 
   std::unique_ptr<Impl> impl_;
 };

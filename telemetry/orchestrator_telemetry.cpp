@@ -31,8 +31,8 @@ struct BusState {
   BusStatsSnapshot published;
   bool change = true;
   bool removed = false;
-  PublisherLoop::Clock::time_point written{};
-  PublisherLoop::Clock::time_point due{};
+  TimePoint written{};
+  TimePoint due{};
   std::uint32_t serial = 0;
 };
 
@@ -117,6 +117,16 @@ struct OrchestratorTelemetry::Impl {
 OrchestratorTelemetry::OrchestratorTelemetry(const Participant& participant,
                                              OrchestratorTelemetryOptions options)
     : PublisherLoop(options.min_interval) {
+  Init(participant, options);
+}
+
+OrchestratorTelemetry::OrchestratorTelemetry(const Participant& participant,
+                                             OrchestratorTelemetryOptions options, Scheduler& scheduler)
+    : PublisherLoop(options.min_interval, scheduler) {
+  Init(participant, options);
+}
+
+void OrchestratorTelemetry::Init(const Participant& participant, OrchestratorTelemetryOptions options) {
   if (options.period <= std::chrono::milliseconds::zero()) throw std::invalid_argument("period must be > 0");
   impl_ = std::make_unique<Impl>(participant, options);
   Start();
@@ -193,13 +203,13 @@ void OrchestratorTelemetry::ConsumeLocked(bool inputs) {
   m.pending.clear();
 }
 
-PublisherLoop::Clock::time_point OrchestratorTelemetry::Publish(Clock::time_point now, bool force) {
+TimePoint OrchestratorTelemetry::Publish(TimePoint now, bool force) {
   Impl& m = *impl_;
   for (const FaultSnapshot& f : m.fault_batch)
     m.WriteFault(f);
   m.fault_batch.clear();
 
-  Clock::time_point next = now + m.options.period;
+  TimePoint next = now + m.options.period;
   for (auto it = m.buses.begin(); it != m.buses.end();) {
     BusState& bus = it->second;
     if (bus.removed) {

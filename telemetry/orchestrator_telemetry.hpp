@@ -66,6 +66,10 @@ class OrchestratorTelemetry final : private PublisherLoop {
  public:
   /// Creates topics and writers (throws DdsError) and starts the publisher thread.
   explicit OrchestratorTelemetry(const Participant& participant, OrchestratorTelemetryOptions options = {});
+  /// The same on simulated time (tests): no thread; publication runs on `scheduler`'s timers, from
+  /// the thread that advances it, which is also the only thread that may call the methods below.
+  OrchestratorTelemetry(const Participant& participant, OrchestratorTelemetryOptions options,
+                        Scheduler& scheduler);
   ~OrchestratorTelemetry();
   OrchestratorTelemetry(const OrchestratorTelemetry&) = delete;
   OrchestratorTelemetry& operator=(const OrchestratorTelemetry&) = delete;
@@ -84,7 +88,8 @@ class OrchestratorTelemetry final : private PublisherLoop {
  private:
   struct Impl;
   void ConsumeLocked(bool inputs) override;
-  Clock::time_point Publish(Clock::time_point now, bool force) override;
+  void Init(const Participant& participant, OrchestratorTelemetryOptions options);
+  TimePoint Publish(TimePoint now, bool force) override;
 
   std::unique_ptr<Impl> impl_;
 };

@@ -41,6 +41,25 @@ def wait_until(predicate: Callable[[], object], timeout: float = WAIT_TIMEOUT, s
         time.sleep(step)
 
 
+def observe_absence(seen: Callable[[], list], window: float, reason: str) -> list:
+    """Watches for something that must NOT happen, for a bounded observation window; returns what
+    `seen` reported (the caller asserts it is empty), at the first sighting or at the window's end.
+
+    No event says "never": proving that a frame was not sent takes watching the bus for a while,
+    which is real time. `window` (seconds) is that while, and `reason` says why it is long enough
+    for this claim (e.g. "20 periods of the former 50 ms heartbeat"), so that nobody shortens it
+    below what the claim needs or mistakes it for a wait on something that happens.
+    """
+    assert reason, "state why the window is long enough"
+    deadline = time.monotonic() + window
+    while True:
+        found = seen()
+        left = deadline - time.monotonic()
+        if found or left <= 0:
+            return found
+        time.sleep(min(0.05, left))
+
+
 def free_tcp_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))
@@ -94,10 +113,20 @@ class Fleet:
             "orchestrator { start_nodes: false }",
             f'bus {{ name: "{self.bus}" bitrate: 500000 socketcand_port: {self.socketcand_port} }}',
         ]
+        # A device with several CAN ports has its port 1 on can0 (python-canopen's bus) and each
+        # further port on a bus of its own (can1, ...) without a socketcand endpoint: the suite
+        # checks port 1.
+        for p in range(1, max(v.ports for v in variants)):
+            lines.append(f'bus {{ name: "{self.port_bus(p)}" bitrate: 500000 }}')
         for v in variants:
             kind = f'device: "{v.device}"' if v.device else f'eds: "{v.eds}"'
-            lines.append(f'node {{ name: "{v.name}" {kind} node_id: {v.node_id} bus: "{self.bus}" external: true }}')
+            buses = " ".join(f'bus: "{self.port_bus(p)}"' for p in range(v.ports))
+            lines.append(f'node {{ name: "{v.name}" {kind} node_id: {v.node_id} {buses} external: true }}')
         return "\n".join(lines) + "\n"
+
+    def port_bus(self, port: int) -> str:
+        """The bus of a node's CAN port `port` (0-based): can0 for port 1, can1 for port 2, ..."""
+        return self.bus if port == 0 else f"can{port}"
 
     def _read_ready(self) -> bool:
         if self.proc.poll() is not None:
@@ -193,8 +222,10 @@ class NodeUnderTest:
 
     def command(self, node_id: Optional[int] = None) -> List[str]:
         cmd = [str(self.fleet.bin_dir / "canfleet-node"), *self.variant.node_args(), "--name", self.variant.name,
-               "--node-id", str(node_id or self.variant.node_id), "--bus", f"{self.fleet.bus}@{self.fleet.broker}",
-               "--state-dir", str(self.state_dir), "--no-telemetry", "--log-level", "debug"]
+               "--node-id", str(node_id or self.variant.node_id)]
+        for port in range(self.variant.ports):
+            cmd += ["--bus", f"{self.fleet.port_bus(port)}@{self.fleet.broker}"]
+        cmd += ["--state-dir", str(self.state_dir), "--no-telemetry", "--log-level", "debug"]
         for io in self.variant.default_io:
             cmd += ["--io", io]
         return cmd + self.extra_args

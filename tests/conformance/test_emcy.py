@@ -3,9 +3,7 @@
 the error also enters 1003h (§7.5.2.3) and clearing it sends 0000h (error reset)."""
 from __future__ import annotations
 
-import time
-
-from harness import wait_until
+from harness import observe_absence, wait_until
 
 HB_NODE = 0x63  # a heartbeat producer that python-canopen plays, then lets fall silent
 
@@ -54,9 +52,11 @@ def test_lost_heartbeat_raises_emcy_8130(node, variant):
     try:
         remote.sdo[0x1016][1].raw = (HB_NODE << 16) | 500
         # The consumer starts with the first heartbeat after the write (socketcand does not echo
-        # our own frames, so they cannot be counted here): a second of them is plenty.
-        time.sleep(1.0)
-        assert remote.emcy.log == [], "EMCY while the heartbeat was still produced"
+        # our own frames, so they cannot be counted here).
+        early = observe_absence(lambda: list(remote.emcy.log), 1.0,
+                                "two consumer times (500 ms) with a heartbeat every 50 ms: a consumer that "
+                                "missed them would have raised its event by then")
+        assert early == [], "EMCY while the heartbeat was still produced"
     finally:
         producer.stop()
     emcy = wait_emcy(remote, 0x8130)

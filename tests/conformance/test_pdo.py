@@ -3,9 +3,7 @@
 values SDO reads, and an RPDO python-canopen sends changes the objects it maps."""
 from __future__ import annotations
 
-import time
-
-from harness import wait_until
+from harness import observe_absence, wait_until
 from test_nmt import wait_heartbeat_state
 
 PDO_NOT_VALID = 1 << 31
@@ -19,7 +17,11 @@ def eds_pdo(od, com_index, map_index):
     entries = []
     for sub in range(1, (mp[0].default or 0) + 1):
         value = mp[sub].default
-        entries.append((value >> 16, (value >> 8) & 0xFF, value & 0xFF))
+        # An entry of 0 maps nothing (0 bits), as python-canopen's PdoMap.read() reads it: the power
+        # supply's manual counts such entries in sub 0 ("4: 60110120h, 60120120h, 0, 0", UMAX080311
+        # §2.2.15, its README-dictionary choice 5).
+        if value:
+            entries.append((value >> 16, (value >> 8) & 0xFF, value & 0xFF))
     return cob & 0x1FFFFFFF, not cob & PDO_NOT_VALID, com[2].default, timer, entries
 
 
@@ -53,8 +55,12 @@ def test_tpdos_decode_after_nmt_start(node, variant, fleet):
     cob_ids = {p.cob_id for p in periodic.values()}
     # Pre-operational: none of them on the bus.
     mark = node.frames.mark()
-    time.sleep(1.0)
-    assert [m for m in node.frames.since(mark) if m.arbitration_id in cob_ids] == []
+    longest = max(p.event_timer for p in periodic.values()) / 1000.0
+    early = observe_absence(lambda: [m for m in node.frames.since(mark) if m.arbitration_id in cob_ids],
+                            max(1.0, 2 * longest),
+                            "two event-timer periods of the slowest of these TPDOs (at least 1 s): "
+                            "each would have been sent at least once")
+    assert early == []
 
     received = {}
     for n, pdo in periodic.items():

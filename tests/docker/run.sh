@@ -17,6 +17,9 @@
 # without having run. Exit 1 on any failed check ("FAIL: ..."), 2 on bad arguments.
 #
 # What it checks (quad-6 and dio-20 consume quad-5's heartbeat, 1500 ms; topologies/docker.textproto):
+#  0. a clean machine: scripts/install-deps.sh in a fresh container of the project's base image
+#     (scripts/docker-base-image.sh), then `install-deps.sh --check`: every program a script or test
+#     calls is there (CANFLEET_DEPS_FRESH=1 repeats the install even when its result is cached)
 #  1. every node attached to the broker and operational, read through the control API published on
 #     127.0.0.1 (host CLI, build/bin/canfleet, when built); the orchestrator configured the external
 #     nodes: quad-6's RPDO1 COB-ID 1400h sub 1 = 185h, quad-5's 1016h sub 1 = 000705DCh
@@ -68,13 +71,52 @@ if ! timeout 30 docker info >/dev/null 2>&1; then
   echo "docker-test: SKIPPED: the Docker engine does not answer ('docker info' failed or timed out)"
   exit 0
 fi
+# ---- 0. a clean machine: the install step in a fresh container of the base image -----------------
+# scripts/install-deps.sh runs in a new container of the project's minimal Debian 12 base image (as a
+# new user's machine), then its --check looks for every program a script or test calls: one that
+# only the developers' machines happen to have fails here. The installed container is kept as an
+# image named after the base image and the script's content, so later runs repeat only the check
+# until either changes (CANFLEET_DEPS_FRESH=1 installs afresh anyway).
+clean_machine() {
+  local base="${CANFLEET_BASE_IMAGE:-canfleet/debian:bookworm}" key image name t out
+  t=$(date +%s)
+  if ! docker image inspect "$base" >/dev/null 2>&1; then
+    case "$base" in
+      canfleet/debian:*) scripts/docker-base-image.sh --tag "$base" || fail "scripts/docker-base-image.sh could not make $base" ;;
+      *) fail "base image $base is not here (and is not ours to make)" ;;
+    esac
+  fi
+  key=$({ docker image inspect -f '{{.Id}}' "$base"; cat scripts/install-deps.sh; } | sha256sum | cut -c1-16)
+  image="canfleet/install-deps-check:$key"
+  if [ "${CANFLEET_DEPS_FRESH:-0}" = 1 ] || ! docker image inspect "$image" >/dev/null 2>&1; then
+    name="canfleet-install-deps-$$"
+    mkdir -p build-docker
+    # docker cp rather than a bind mount: works with an engine that does not see this file system.
+    docker create --name "$name" "$base" bash /opt/install-deps.sh >/dev/null || fail "docker create from $base failed"
+    docker cp scripts/install-deps.sh "$name:/opt/install-deps.sh" >/dev/null
+    if ! timeout 1800 docker start -a "$name" >build-docker/install-deps.log 2>&1; then
+      tail -n 20 build-docker/install-deps.log >&2
+      docker rm -f "$name" >/dev/null 2>&1 || true
+      fail "scripts/install-deps.sh failed in a fresh container of $base (log: build-docker/install-deps.log)"
+    fi
+    docker commit "$name" "$image" >/dev/null || fail "docker commit of the installed container failed"
+    docker rm "$name" >/dev/null
+    # Older results (another script or base image) are of no further use.
+    docker image ls --format '{{.Repository}}:{{.Tag}}' canfleet/install-deps-check | grep -vx "$image" |
+      xargs -r docker rmi >/dev/null 2>&1 || true
+  fi
+  out=$(docker run --rm "$image" bash /opt/install-deps.sh --check 2>&1) ||
+    fail "after scripts/install-deps.sh in a fresh container of $base: $out"
+  pass "clean machine: scripts/install-deps.sh in a fresh $base container, then every program found (${out#install-deps: }, $(elapsed "$t"))"
+}
+t0=$(date +%s)
+elapsed() { echo "$(($(date +%s) - $1)) s"; }
+clean_machine
+
 if ! docker compose version >/dev/null 2>&1 && ! command -v docker-compose >/dev/null; then
   fail "a Docker engine answers but no compose tool is installed ('docker compose' v2 or 'docker-compose')"
 fi
 command -v python3 >/dev/null || fail "python3 is needed to read canfleet status --json"
-
-t0=$(date +%s)
-elapsed() { echo "$(($(date +%s) - $1)) s"; }
 
 # ---- a project and host ports of its own ---------------------------------------------------------
 export CANFLEET_PROJECT="canfleet-test-$$"

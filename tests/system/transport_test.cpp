@@ -301,7 +301,7 @@ struct NullSink : broker::PortSink {
 
 TEST_F(Transport, ASlowReaderLosesFramesAndNobodyElseDoes) {
   // A node that stops reading is not allowed to make the broker buffer without bound: beyond
-  // ServerOptions::max_backlog_bytes its deliveries are dropped and counted; the others go on.
+  // BrokerServerOptions::max_backlog_bytes its deliveries are dropped and counted; the others go on.
   LogCapture log;
   broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false, .tx_queue_capacity = 1 << 20});
   transport::BrokerServer server(io_, broker_, {.max_backlog_bytes = 64 * 1024});

@@ -24,9 +24,21 @@ using canopen::SubObject;
 using od_table::TableLine;
 using od_table::Trim;
 
-enum Column : std::size_t { kIndex, kKind, kName, kType, kAccess, kPdo, kDefault, kLow, kHigh, kManual, kColumns };
-constexpr std::array<std::string_view, kColumns> kColumnNames = {"index", "kind",    "name", "type", "access",
-                                                                 "pdo",   "default", "low",  "high", "manual"};
+enum Column : std::size_t {
+  kIndex,
+  kKind,
+  kName,
+  kType,
+  kAccess,
+  kPdo,
+  kDefault,
+  kLow,
+  kHigh,
+  kManual,
+  kColumns
+};
+constexpr std::array<std::string_view, kColumns> kColumnNames = {
+    "index", "kind", "name", "type", "access", "pdo", "default", "low", "high", "manual"};
 
 /// The row being read, for located errors.
 struct Row {
@@ -96,12 +108,13 @@ DataType ParseType(const Row& row) {
     auto type = static_cast<DataType>(code);
     if (canopen::IsKnown(type) && canopen::ToString(type) == text) return type;
   }
-  row.Fail(kType, "\"" + std::string(text) + "\" is not a CiA 301 data type (UNSIGNED8, INTEGER16, REAL32...)");
+  row.Fail(kType,
+           "\"" + std::string(text) + "\" is not a CiA 301 data type (UNSIGNED8, INTEGER16, REAL32...)");
 }
 
 bool IsStringType(DataType type) {
-  return type == DataType::kVisibleString || type == DataType::kOctetString || type == DataType::kUnicodeString ||
-         type == DataType::kDomain;
+  return type == DataType::kVisibleString || type == DataType::kOctetString ||
+         type == DataType::kUnicodeString || type == DataType::kDomain;
 }
 
 /// A cell's values for `count` sub-objects: one value for all, or a list ("40*7,10000*5").
@@ -110,7 +123,8 @@ std::vector<std::string_view> ValueList(const Row& row, Column column, DataType 
   if (IsStringType(type) || text.find(',') == std::string_view::npos) {
     std::string_view one = text;
     auto star = one.rfind('*');
-    std::optional<unsigned> repeat = star == std::string_view::npos ? std::nullopt : Decimal(one.substr(star + 1));
+    std::optional<unsigned> repeat =
+        star == std::string_view::npos ? std::nullopt : Decimal(one.substr(star + 1));
     if (!IsStringType(type) && repeat) {
       if (*repeat != count)
         row.Fail(column, "\"" + std::string(text) + "\" gives " + std::to_string(*repeat) + " values for " +
@@ -124,7 +138,8 @@ std::vector<std::string_view> ValueList(const Row& row, Column column, DataType 
     auto comma = text.find(',');
     std::string_view item = Trim(text.substr(0, comma));
     auto star = item.rfind('*');
-    std::optional<unsigned> repeat = star == std::string_view::npos ? std::nullopt : Decimal(item.substr(star + 1));
+    std::optional<unsigned> repeat =
+        star == std::string_view::npos ? std::nullopt : Decimal(item.substr(star + 1));
     if (star != std::string_view::npos && !repeat)
       row.Fail(column, "\"" + std::string(item) + "\": a repeat is VALUE*COUNT");
     std::string_view value = repeat ? Trim(item.substr(0, star)) : item;
@@ -137,8 +152,8 @@ std::vector<std::string_view> ValueList(const Row& row, Column column, DataType 
     text.remove_prefix(comma + 1);
   }
   if (values.size() != count)
-    row.Fail(column, "the list gives " + std::to_string(values.size()) + " values for " + std::to_string(count) +
-                         " sub-objects");
+    row.Fail(column, "the list gives " + std::to_string(values.size()) + " values for " +
+                         std::to_string(count) + " sub-objects");
   return values;
 }
 
@@ -157,13 +172,15 @@ std::pair<unsigned, unsigned> ParseSubRun(const Row& row) {
   auto first = Decimal(text.substr(0, dots));
   auto last = dots == std::string_view::npos ? first : Decimal(text.substr(dots + 2));
   if (!first || !last || *last < *first || *last > 0xFE)
-    row.Fail(kKind, "\"" + std::string(text) + "\" is not VAR, ARRAY, RECORD, a sub-index or FIRST..LAST (0..254)");
+    row.Fail(kKind,
+             "\"" + std::string(text) + "\" is not VAR, ARRAY, RECORD, a sub-index or FIRST..LAST (0..254)");
   return {*first, *last};
 }
 
 std::string SubName(std::string_view pattern, unsigned sub, unsigned position) {
   std::string name(pattern);
-  for (auto [token, value] : {std::pair{std::string_view("{n}"), sub}, std::pair{std::string_view("{i}"), position}}) {
+  for (auto [token, value] :
+       {std::pair{std::string_view("{n}"), sub}, std::pair{std::string_view("{i}"), position}}) {
     for (auto at = name.find(token); at != std::string::npos; at = name.find(token))
       name.replace(at, token.size(), std::to_string(value));
   }
@@ -195,8 +212,10 @@ class TableReader {
     if (IsHeaderOrRule(row.cells)) return;
     if (row.cells.size() != kColumns) {
       throw OdTableError(std::string(file_), line.number, "",
-                         "a row has " + std::to_string(kColumns) + " cells (index | kind | name | type | access | pdo | "
-                         "default | low | high | manual), this one " + std::to_string(row.cells.size()));
+                         "a row has " + std::to_string(kColumns) +
+                             " cells (index | kind | name | type | access | pdo | "
+                             "default | low | high | manual), this one " +
+                             std::to_string(row.cells.size()));
     }
     std::uint16_t index = ParseIndex(row);
     std::string_view kind = row[kKind];
@@ -214,16 +233,21 @@ class TableReader {
     Object object;
     object.index = index;
     object.name = std::string(row[kName]);
-    object.code = kind == "VAR" ? ObjectCode::kVar : kind == "ARRAY" ? ObjectCode::kArray : ObjectCode::kRecord;
+    object.code = kind == "VAR"     ? ObjectCode::kVar
+                  : kind == "ARRAY" ? ObjectCode::kArray
+                                    : ObjectCode::kRecord;
     if (object.code != ObjectCode::kVar) {
       for (Column c : {kType, kAccess, kPdo, kDefault, kLow, kHigh}) {
-        if (!row[c].empty()) row.Fail(c, "an ARRAY or RECORD row leaves this cell empty: its sub-objects carry it");
+        if (!row[c].empty())
+          row.Fail(c, "an ARRAY or RECORD row leaves this cell empty: its sub-objects carry it");
       }
       out_.od.Add(std::move(object));
       lines_[index] = row.line;
       return;
     }
-    object.subs.emplace(0, MakeSub(row, index, 0, row[kName], 1, 0, 0));
+    SubObject var = MakeSub(row, index, 0, row[kName], 1, 0, 0);
+    var.name = object.name;  // a VAR has one ParameterName (CiA 306 §4.5.2): {n} is for runs only
+    object.subs.emplace(0, std::move(var));
     out_.od.Add(std::move(object));
     lines_[index] = row.line;
   }
@@ -231,7 +255,8 @@ class TableReader {
   void ReadSubObjects(const Row& row, std::uint16_t index) {
     Object* object = out_.od.Find(index);
     if (!object) row.Fail(kIndex, "sub-objects of " + Hex(index) + "h come after its ARRAY or RECORD row");
-    if (object->code == ObjectCode::kVar) row.Fail(kKind, Hex(index) + "h is a VAR: it has no further sub-objects");
+    if (object->code == ObjectCode::kVar)
+      row.Fail(kKind, Hex(index) + "h is a VAR: it has no further sub-objects");
     auto [first, last] = ParseSubRun(row);
     std::size_t count = last - first + 1;
     DataType type = ParseType(row);
@@ -245,20 +270,25 @@ class TableReader {
   }
 
   /// One sub-object of a row: value `position` (0-based) of lists of `count` values.
-  SubObject MakeSub(const Row& row, std::uint16_t index, unsigned sub, std::string_view name, unsigned ordinal,
-                    std::size_t position, std::size_t count, std::optional<DataType> known_type = std::nullopt) {
+  SubObject MakeSub(const Row& row, std::uint16_t index, unsigned sub, std::string_view name,
+                    unsigned ordinal, std::size_t position, std::size_t count,
+                    std::optional<DataType> known_type = std::nullopt) {
     DataType type = known_type ? *known_type : ParseType(row);
     auto access = canopen::ParseAccess(row[kAccess]);
-    if (!access) row.Fail(kAccess, "\"" + std::string(row[kAccess]) + "\" is not ro, wo, rw, rwr, rww or const");
-    if (row[kPdo] != "0" && row[kPdo] != "1") row.Fail(kPdo, "\"" + std::string(row[kPdo]) + "\" is not 0 or 1");
+    if (!access)
+      row.Fail(kAccess, "\"" + std::string(row[kAccess]) + "\" is not ro, wo, rw, rwr, rww or const");
+    if (row[kPdo] != "0" && row[kPdo] != "1")
+      row.Fail(kPdo, "\"" + std::string(row[kPdo]) + "\" is not 0 or 1");
     std::size_t n = count == 0 ? 1 : count;
     std::size_t at = count == 0 ? 0 : position;
     if (row[kDefault].empty() && !IsStringType(type)) row.Fail(kDefault, "a default is needed");
     canopen::EdsValue value = ParseValue(row, kDefault, type, ValueList(row, kDefault, type, n)[at]);
-    SubObject made = canopen::MakeSubObject(SubName(name, sub, ordinal), type, *access, value.bytes, row[kPdo] == "1");
+    SubObject made =
+        canopen::MakeSubObject(SubName(name, sub, ordinal), type, *access, value.bytes, row[kPdo] == "1");
     made.sub_index = static_cast<std::uint8_t>(sub);
     made.default_adds_node_id = value.adds_node_id;
-    for (auto [column, limit] : {std::pair{kLow, &SubObject::low_limit}, std::pair{kHigh, &SubObject::high_limit}}) {
+    for (auto [column, limit] :
+         {std::pair{kLow, &SubObject::low_limit}, std::pair{kHigh, &SubObject::high_limit}}) {
       if (row[column].empty()) continue;
       canopen::EdsValue bound = ParseValue(row, column, type, ValueList(row, column, type, n)[at]);
       made.*limit = bound.bytes;
@@ -288,8 +318,8 @@ class TableReader {
       unsigned highest = object.subs.rbegin()->first;
       if (sub0->second.default_value.size() == 1 && sub0->second.default_value[0] != highest &&
           sub0->second.access == canopen::Access::kRo && object.code == ObjectCode::kArray) {
-        fail("sub-index 0 says " + std::to_string(sub0->second.default_value[0]) + " but the highest sub-index is " +
-             std::to_string(highest));
+        fail("sub-index 0 says " + std::to_string(sub0->second.default_value[0]) +
+             " but the highest sub-index is " + std::to_string(highest));
       }
     }
     if (!facts_.nr_of_rx_pdo) out_.device_info.nr_of_rx_pdo = rx;

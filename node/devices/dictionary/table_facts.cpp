@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 
+#include "node/canopen/eds/eds_file_info.hpp"
 #include "node/canopen/eds/eds_number.hpp"
 #include "node/devices/dictionary/od_table.hpp"
 #include "node/devices/dictionary/table_lines.hpp"
@@ -26,8 +27,9 @@ struct FactContext {
   template <typename T>
   T Number() const {
     auto n = canopen::ParseUnsignedLiteral(value, std::numeric_limits<T>::max());
-    if (!n) Fail("\"" + std::string(value) + "\" is not a number from 0 to " +
-                 std::to_string(std::numeric_limits<T>::max()));
+    if (!n)
+      Fail("\"" + std::string(value) + "\" is not a number from 0 to " +
+           std::to_string(std::numeric_limits<T>::max()));
     return static_cast<T>(*n);
   }
   bool Flag() const { return Number<std::uint8_t>() != 0; }
@@ -49,14 +51,28 @@ using Setter = std::function<void(const FactContext&, canopen::EdsFile&, FactsSe
 
 template <typename T>
 Setter Text(T canopen::FileInfo::*field) {
-  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.file_info.*field = std::string(c.value); };
+  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) {
+    f.file_info.*field = std::string(c.value);
+  };
+}
+/// A date or time fact, in the spelling the EDS reader takes back (CiA 306 §4.3).
+Setter Checked(std::string canopen::FileInfo::*field, bool (*valid)(std::string_view),
+               std::string_view format) {
+  return [field, valid, format](const FactContext& c, canopen::EdsFile& f, FactsSeen&) {
+    if (!valid(c.value)) c.Fail("\"" + std::string(c.value) + "\" is not " + std::string(format));
+    f.file_info.*field = std::string(c.value);
+  };
 }
 Setter DeviceText(std::string canopen::DeviceInfo::*field) {
-  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.device_info.*field = std::string(c.value); };
+  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) {
+    f.device_info.*field = std::string(c.value);
+  };
 }
 template <typename T>
 Setter DeviceNumber(T canopen::DeviceInfo::*field) {
-  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.device_info.*field = c.Number<T>(); };
+  return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) {
+    f.device_info.*field = c.Number<T>();
+  };
 }
 Setter DeviceFlag(bool canopen::DeviceInfo::*field) {
   return [field](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.device_info.*field = c.Flag(); };
@@ -68,16 +84,16 @@ const std::map<std::string_view, Setter>& Setters() {
   static const std::map<std::string_view, Setter> setters = {
       {"file_name", Text(&FileInfo::file_name)},
       {"description", Text(&FileInfo::description)},
-      {"creation_date", Text(&FileInfo::creation_date)},
-      {"creation_time", Text(&FileInfo::creation_time)},
+      {"creation_date", Checked(&FileInfo::creation_date, canopen::IsEdsDate, "a date (mm-dd-yyyy)")},
+      {"creation_time", Checked(&FileInfo::creation_time, canopen::IsEdsTime, "a time (hh:mmAM)")},
       {"created_by", Text(&FileInfo::created_by)},
-      {"modification_date", Text(&FileInfo::modification_date)},
-      {"modification_time", Text(&FileInfo::modification_time)},
+      {"modification_date", Checked(&FileInfo::modification_date, canopen::IsEdsDate, "a date (mm-dd-yyyy)")},
+      {"modification_time", Checked(&FileInfo::modification_time, canopen::IsEdsTime, "a time (hh:mmAM)")},
       {"modified_by", Text(&FileInfo::modified_by)},
-      {"file_version",
-       [](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.file_info.file_version = c.Number<std::uint8_t>(); }},
-      {"file_revision",
-       [](const FactContext& c, canopen::EdsFile& f, FactsSeen&) { f.file_info.file_revision = c.Number<std::uint8_t>(); }},
+      {"file_version", [](const FactContext& c, canopen::EdsFile& f,
+                          FactsSeen&) { f.file_info.file_version = c.Number<std::uint8_t>(); }},
+      {"file_revision", [](const FactContext& c, canopen::EdsFile& f,
+                           FactsSeen&) { f.file_info.file_revision = c.Number<std::uint8_t>(); }},
       {"vendor_name", DeviceText(&DeviceInfo::vendor_name)},
       {"product_name", DeviceText(&DeviceInfo::product_name)},
       {"order_code", DeviceText(&DeviceInfo::order_code)},
@@ -104,7 +120,8 @@ const std::map<std::string_view, Setter>& Setters() {
        [](const FactContext& c, canopen::EdsFile& f, FactsSeen&) {
          c.ForEachNumber<std::uint16_t>([&](std::uint16_t kbit) {
            static const std::set<std::uint16_t> kCia306 = {10, 20, 50, 125, 250, 500, 800, 1000};
-           if (!kCia306.contains(kbit)) c.Fail(std::to_string(kbit) + " kbit/s is not a CiA 306 BaudRate_ key");
+           if (!kCia306.contains(kbit))
+             c.Fail(std::to_string(kbit) + " kbit/s is not a CiA 306 BaudRate_ key");
            f.device_info.baud_rates_kbit.insert(kbit);
          });
        }},

@@ -1,6 +1,7 @@
 #include "node/devices/dictionary/table_lines.hpp"
 
 #include <charconv>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -54,8 +55,9 @@ std::vector<std::string> RangeValues(std::string_view range, std::string_view fi
   const auto first = Decimal(first_text);
   const auto last = Decimal(dots == std::string_view::npos ? std::string_view() : range.substr(dots + 2));
   if (!first.has_value() || !last.has_value() || *last < *first || *last - *first >= 1000) {
-    throw OdTableError(std::string(file), line, "",
-                       "@for range \"" + std::string(range) + "\" is not FIRST..LAST (decimal, at most 1000 values)");
+    throw OdTableError(
+        std::string(file), line, "",
+        "@for range \"" + std::string(range) + "\" is not FIRST..LAST (decimal, at most 1000 values)");
   }
   const unsigned from = *first;
   const unsigned to = *last;
@@ -79,10 +81,12 @@ Loop ParseLoopHeader(std::string_view text, std::string_view file, std::size_t l
     LoopVariable variable{std::string(words[i]), RangeValues(words[i + 1], file, line)};
     for (char c : variable.name) {
       if (!IsNameChar(c))
-        throw OdTableError(std::string(file), line, "", "@for variable \"" + variable.name + "\" is not a name");
+        throw OdTableError(std::string(file), line, "",
+                           "@for variable \"" + variable.name + "\" is not a name");
     }
     if (!loop.variables.empty() && loop.variables.front().values.size() != variable.values.size()) {
-      throw OdTableError(std::string(file), line, "", "@for ranges advance together and must have the same length");
+      throw OdTableError(std::string(file), line, "",
+                         "@for ranges advance together and must have the same length");
     }
     loop.variables.push_back(std::move(variable));
   }
@@ -117,6 +121,21 @@ void CloseLoop(std::vector<Loop>& open, std::vector<TableLine>& out, std::string
   }
 }
 
+/// Every line but a comment becomes EDS text, which holds no control character but tab (CiA 306
+/// files are lines of text; the EDS writer refuses them, and a table must not give an EDS that
+/// cannot be written).
+void CheckPrintable(std::string_view line, std::string_view file_name, std::size_t number) {
+  for (char c : line) {
+    const auto byte = static_cast<unsigned char>(c);
+    if ((byte < 0x20 && byte != '\t') || byte == 0x7F) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "%02Xh", byte);
+      throw OdTableError(std::string(file_name), number, "",
+                         std::string("a control character (") + hex + ") in a line: tables are text");
+    }
+  }
+}
+
 }  // namespace
 
 std::string_view Trim(std::string_view text) {
@@ -139,8 +158,10 @@ std::vector<TableLine> ExpandLines(std::string_view text, std::string_view file_
     text.remove_prefix(newline == std::string_view::npos ? text.size() : newline + 1);
     std::string_view line = Trim(raw);
     if (line.empty() || line.front() == '#') continue;
+    CheckPrintable(line, file_name, number);
     if (line.starts_with("@for ") || line == "@for") {
-      if (open.size() >= 8) throw OdTableError(std::string(file_name), number, "", "@for loops nest at most 8 deep");
+      if (open.size() >= 8)
+        throw OdTableError(std::string(file_name), number, "", "@for loops nest at most 8 deep");
       open.push_back(ParseLoopHeader(line, file_name, number));
     } else if (line == "@end") {
       if (open.empty()) throw OdTableError(std::string(file_name), number, "", "@end without @for");

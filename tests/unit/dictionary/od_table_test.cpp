@@ -33,7 +33,8 @@ std::string ErrorOf(const std::string& text) {
 }
 
 TEST(OdTable, AVarRowIsAnObjectWithSubIndexZero) {
-  const auto eds = Parse("| 1017 | VAR | Producer Heartbeat Time | UNSIGNED16 | rw | 0 | 500 | 10 | 65535 | 3.2.7 |\n");
+  const auto eds =
+      Parse("| 1017 | VAR | Producer Heartbeat Time | UNSIGNED16 | rw | 0 | 500 | 10 | 65535 | 3.2.7 |\n");
   const auto* sub = eds.od.Find(0x1017, 0);
   ASSERT_NE(sub, nullptr);
   EXPECT_EQ(eds.od.Find(0x1017)->code, ObjectCode::kVar);
@@ -44,6 +45,14 @@ TEST(OdTable, AVarRowIsAnObjectWithSubIndexZero) {
   EXPECT_EQ(canopen::DecodeUnsignedLe(sub->value), 500u);
   EXPECT_EQ(canopen::DecodeUnsignedLe(*sub->low_limit), 10u);
   EXPECT_EQ(canopen::DecodeUnsignedLe(*sub->high_limit), 65535u);
+}
+
+// Found by fuzz/od_table: the VAR's sub-index 0 was named "a0" while the object was "a{n}", so
+// the EDS (one ParameterName per VAR, CiA 306 §4.5.2) read back differently.
+TEST(OdTable, AVarsNameIsTakenAsWrittenEvenWithARunPlaceholder) {
+  const auto eds = Parse("| 2000 | VAR | a{n} | U8 | rw | 0 | 0 | | | 3 |\n");
+  EXPECT_EQ(eds.od.Find(0x2000)->name, "a{n}");
+  EXPECT_EQ(eds.od.Find(0x2000, 0)->name, "a{n}");
 }
 
 TEST(OdTable, ARunGivesEverySubItsNameAndItsValueFromTheList) {
@@ -126,11 +135,13 @@ INSTANTIATE_TEST_SUITE_P(
                 "t.od:1: column \"default\": \"0x1G\" is not a number"},
         BadCase{"\n\n| 100 | VAR | x | U32 | ro | 0 | 0 | | | 3 |\n",
                 "t.od:3: column \"index\": \"100\" is not an index of 4 hex digits"},
-        BadCase{"| 1000 | VAR | x | U33 | ro | 0 | 0 | | | 3 |\n",
-                "t.od:1: column \"type\": \"U33\" is not a CiA 301 data type (UNSIGNED8, INTEGER16, REAL32...)"},
-        BadCase{"| 1000 | VAR | x | U32 | ro | 0 | 0 | | 3 |\n",
-                "t.od:1: a row has 10 cells (index | kind | name | type | access | pdo | default | low | high | "
-                "manual), this one 9"},
+        BadCase{
+            "| 1000 | VAR | x | U33 | ro | 0 | 0 | | | 3 |\n",
+            "t.od:1: column \"type\": \"U33\" is not a CiA 301 data type (UNSIGNED8, INTEGER16, REAL32...)"},
+        BadCase{
+            "| 1000 | VAR | x | U32 | ro | 0 | 0 | | 3 |\n",
+            "t.od:1: a row has 10 cells (index | kind | name | type | access | pdo | default | low | high | "
+            "manual), this one 9"},
         BadCase{"| 1000 | VAR | x | U32 | ro | 0 | 0 | | | |\n",
                 "t.od:1: column \"manual\": an object row cites its manual section"},
         BadCase{"| 2000 | 1 | x | U8 | ro | 0 | 0 | | | |\n",
@@ -141,23 +152,36 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"| 2000 | ARRAY | a | | | | | | | 3 |\n| 2000 | 0 | n | U8 | ro | 0 | 3 | | | |\n"
                 "| 2000 | 1..2 | e{n} | U8 | rw | 0 | 1 | | | |\n",
                 "t.od:1: column \"kind\": 2000h sub-index 0 says 3 but the highest sub-index is 2"},
-        BadCase{"| 2000 | VAR | a | U8 | rw | 2 | 0 | | | 3 |\n", "t.od:1: column \"pdo\": \"2\" is not 0 or 1"},
+        BadCase{"| 2000 | VAR | a | U8 | rw | 2 | 0 | | | 3 |\n",
+                "t.od:1: column \"pdo\": \"2\" is not 0 or 1"},
         BadCase{"| 2000 | VAR | a | U8 | rw | 0 | 300 | | | 3 |\n",
                 "t.od:1: column \"default\": \"300\" is out of range for UNSIGNED8 (0..255)"},
-        BadCase{"@for x 1..3\n| 2000 | VAR | a | U8 | rw | 0 | 0 | | | 3 |\n",
-                "t.od:1: @for without @end"},
+        BadCase{"@for x 1..3\n| 2000 | VAR | a | U8 | rw | 0 | 0 | | | 3 |\n", "t.od:1: @for without @end"},
         BadCase{"@end\n", "t.od:1: @end without @for"},
-        BadCase{"@for x 3..1\n@end\n", "t.od:1: @for range \"3..1\" is not FIRST..LAST (decimal, at most 1000 values)"},
+        BadCase{"@for x 3..1\n@end\n",
+                "t.od:1: @for range \"3..1\" is not FIRST..LAST (decimal, at most 1000 values)"},
         BadCase{"@for x 1..2\n| 2000 | VAR | a | U8 | rw | 0 | 0 | | | 3 |\n@end\n",
                 "t.od:2: column \"index\": object 2000h is defined twice"},
-        BadCase{"@vendor x\n", "t.od:1: unknown fact \"@vendor\" (known: @baud_rates, @comment, @created_by, "
-                               "@creation_date, @creation_time, @description, @dummy_usage, @dynamic_channels_supported, "
-                               "@file_name, @file_revision, @file_version, @granularity, @group_messaging, "
-                               "@lss_supported, @modification_date, @modification_time, @modified_by, @nr_of_rx_pdo, "
-                               "@nr_of_tx_pdo, @order_code, @product_name, @product_number, @revision_number, "
-                               "@simple_boot_up_master, @simple_boot_up_slave, @vendor_name, @vendor_number)"},
-        BadCase{"@baud_rates 125 300\n", "t.od:1: column \"@baud_rates\": 300 kbit/s is not a CiA 306 BaudRate_ key"},
-        BadCase{"just words\n", "t.od:1: a line is a row (|...|), a fact (@key value), @for/@end or a # comment"},
+        BadCase{"@vendor x\n",
+                "t.od:1: unknown fact \"@vendor\" (known: @baud_rates, @comment, @created_by, "
+                "@creation_date, @creation_time, @description, @dummy_usage, @dynamic_channels_supported, "
+                "@file_name, @file_revision, @file_version, @granularity, @group_messaging, "
+                "@lss_supported, @modification_date, @modification_time, @modified_by, @nr_of_rx_pdo, "
+                "@nr_of_tx_pdo, @order_code, @product_name, @product_number, @revision_number, "
+                "@simple_boot_up_master, @simple_boot_up_slave, @vendor_name, @vendor_number)"},
+        BadCase{"@baud_rates 125 300\n",
+                "t.od:1: column \"@baud_rates\": 300 kbit/s is not a CiA 306 BaudRate_ key"},
+        // Found by fuzz/od_table: a date the EDS reader refuses must not reach the generated EDS.
+        BadCase{"@creation_date 01-15-2025\x8d\n",
+                "t.od:1: column \"@creation_date\": \"01-15-2025\x8d\" is not a date (mm-dd-yyyy)"},
+        BadCase{"@modification_time 9:00 o'clock\n",
+                "t.od:1: column \"@modification_time\": \"9:00 o'clock\" is not a time (hh:mmAM)"},
+        // Found by fuzz/od_table: a name with a control character gave an EDS that cannot be written.
+        BadCase{"| 2000 | VAR | a\x04"
+                "b | U8 | rw | 0 | 0 | | | 3 |\n",
+                "t.od:1: a control character (04h) in a line: tables are text"},
+        BadCase{"just words\n",
+                "t.od:1: a line is a row (|...|), a fact (@key value), @for/@end or a # comment"},
         BadCase{"# nothing\n", "t.od:0: the table has no objects"}));
 
 }  // namespace

@@ -1,5 +1,7 @@
-// The socketcand endpoint on real TCP sockets, with the broker on an Asio event loop (real time).
-// Replies and formats as linux-can/socketcand sends them (state_nobus.c, state_raw.c).
+// The socketcand endpoint's sessions on simulated time (sim_endpoint.hpp: socketpair clients, the
+// broker on a SimulatedScheduler). Replies and formats as linux-can/socketcand sends them
+// (state_nobus.c, state_raw.c). The same endpoint over real TCP and real time:
+// tests/integration/socketcand.
 #include "orchestrator/socketcand/server.hpp"
 
 #include <gtest/gtest.h>
@@ -8,7 +10,7 @@
 #include <stdexcept>
 
 #include "tests/support/bus_probe.hpp"
-#include "tests/unit/socketcand/socketcand_test_support.hpp"
+#include "tests/unit/socketcand/sim_endpoint.hpp"
 
 namespace canfleet::socketcand {
 namespace {
@@ -27,7 +29,7 @@ ServerOptions Compact() {
 
 TEST(SocketcandServer, HandshakeAsPythonCanExpectsIt) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.connected());
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< open can0 >");
@@ -39,7 +41,7 @@ TEST(SocketcandServer, HandshakeAsPythonCanExpectsIt) {
 
 TEST(SocketcandServer, UnknownBusIsRefusedAndTheConnectionClosed) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< open can7 >");
   EXPECT_EQ(c.Next(), "< error could not open bus >");
@@ -49,7 +51,7 @@ TEST(SocketcandServer, UnknownBusIsRefusedAndTheConnectionClosed) {
 
 TEST(SocketcandServer, MalformedOpenIsRefusedLikeAnUnknownBus) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< open >");
   EXPECT_EQ(c.Next(), "< error could not open bus >");
@@ -58,7 +60,7 @@ TEST(SocketcandServer, MalformedOpenIsRefusedLikeAnUnknownBus) {
 
 TEST(SocketcandServer, CommandsBeforeOpenAreUnknownButTheSessionLives) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< send 123 0 >");
   EXPECT_EQ(c.Next(), "< error unknown command >");
@@ -66,12 +68,13 @@ TEST(SocketcandServer, CommandsBeforeOpenAreUnknownButTheSessionLives) {
   EXPECT_EQ(c.Next(), "< error unknown command >");
   c.Send("< open can0 >");
   EXPECT_EQ(c.Next(), "< ok >");
-  EXPECT_TRUE(ep.WaitReceived(1, 50ms).empty()) << "nothing was sent before open";
+  ep.RunFor(50ms);
+  EXPECT_TRUE(ep.Received().empty()) << "nothing was sent before open";
 }
 
 TEST(SocketcandServer, RawModeForwardsEveryFrameOfTheOtherPorts) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   CanFrame small_ext = Frame("123#01");
   small_ext.flags |= CanFrame::kExtended;
@@ -91,16 +94,30 @@ TEST(SocketcandServer, RawModeForwardsEveryFrameOfTheOtherPorts) {
     EXPECT_EQ(match[4], data);
     const auto seconds = std::stoll(match[2]);
     EXPECT_NEAR(static_cast<double>(seconds), std::chrono::duration<double>(now).count(), 5.0)
-        << "timestamps are wall-clock time";
+        << "timestamps are wall-clock time (bus time 0 = when the server was made)";
   }
   const auto rtr = c.Next();
   ASSERT_TRUE(rtr.has_value());
   EXPECT_TRUE(std::regex_match(*rtr, std::regex(R"(< rtr 705 \d+\.\d{6} 1 >)"))) << *rtr;
 }
 
+TEST(SocketcandServer, TimestampsFollowBusTimeFromTheWallClockOrigin) {
+  ServerOptions o = Compact();
+  o.wall_origin = WallTime{std::chrono::seconds(1'700'000'000)};
+  Endpoint ep(o);
+  Client c(ep);
+  ASSERT_TRUE(c.Handshake());
+  ep.RunFor(2500ms);
+  ep.Send({Frame("123#01")});
+  const auto m = c.Next();
+  ASSERT_TRUE(m.has_value());
+  // Sent at bus time 2.5 s; on the wire 1 Mbit/s: 1700000002.5xxxxx.
+  EXPECT_TRUE(std::regex_match(*m, std::regex(R"(< frame 123 1700000002\.5\d{5} 01 >)"))) << *m;
+}
+
 TEST(SocketcandServer, ClientFramesReachTheBusAndAreNotEchoed) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   c.Send("< send 181 3 de ad 5 >< send 1AAAAAAA 2 1 F1 >< sendrtr 705 0 >");
   c.Send("< send 00000181 0 >");
@@ -117,13 +134,14 @@ TEST(SocketcandServer, ClientFramesReachTheBusAndAreNotEchoed) {
 
 TEST(SocketcandServer, SendWorksInBcmModeButFramesAreForwardedInRawModeOnly) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< open can0 >");
   EXPECT_EQ(c.Next(), "< ok >");
   c.Send("< send 100 1 01 >");
   EXPECT_EQ(ep.WaitReceived(1), (std::vector<CanFrame>{Frame("100#01")}));
   ep.Send({Frame("200#02")});
+  ep.RunFor(10ms);  // 200h is on the wire while the session is in BCM mode
   c.Send("< subscribe 0 0 200 >");
   EXPECT_EQ(c.Next(), "< error command not supported >") << "no frame before it";
   c.Send("< rawmode >");
@@ -135,13 +153,14 @@ TEST(SocketcandServer, SendWorksInBcmModeButFramesAreForwardedInRawModeOnly) {
   c.Send("< bcmmode >");
   EXPECT_EQ(c.Next(), "< ok >");
   ep.Send({Frame("400#04")});
+  ep.RunFor(10ms);  // 400h is on the wire
   c.Send("< echo >");
   EXPECT_EQ(c.Next(), "< echo >") << "no frame forwarded in BCM mode";
 }
 
 TEST(SocketcandServer, MalformedSendIsIgnoredAndTheSessionLives) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   c.Send("< send 123 2 01 >< send 800000000 0 >< send 123 9 >< send >");
   c.Send("< echo >");
@@ -157,7 +176,7 @@ TEST(SocketcandServer, MalformedSendIsIgnoredAndTheSessionLives) {
 
 TEST(SocketcandServer, GarbageIsSkipped) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   std::string garbage;
   for (int i = 0; i < 20000; ++i)
@@ -169,35 +188,32 @@ TEST(SocketcandServer, GarbageIsSkipped) {
 
 TEST(SocketcandServer, OverlongCommandClosesOnlyThatConnection) {
   Endpoint ep(Compact());
-  Client bad(ep.port());
-  Client good(ep.port());
+  Client bad(ep);
+  Client good(ep);
   ASSERT_TRUE(bad.Handshake());
   ASSERT_TRUE(good.Handshake());
   bad.Send("< send " + std::string(1000, '1'));
   EXPECT_TRUE(bad.ClosedByServer());
   good.Send("< send 123 0 >");
   EXPECT_EQ(ep.WaitReceived(1), (std::vector<CanFrame>{Frame("123#")}));
-  Client again(ep.port());
-  EXPECT_TRUE(again.Handshake()) << "the server keeps accepting";
+  Client again(ep);
+  EXPECT_TRUE(again.Handshake()) << "the server keeps serving";
 }
 
 TEST(SocketcandServer, ADisconnectedClientsPortIsDetached) {
   Endpoint ep(Compact());
-  {
-    Client c(ep.port());
-    ASSERT_TRUE(c.Handshake());
-    EXPECT_EQ(ep.PortsOnBus(), 2u);
-  }
-  for (int i = 0; i < 200 && ep.PortsOnBus() != 1; ++i)
-    std::this_thread::sleep_for(5ms);
-  EXPECT_EQ(ep.PortsOnBus(), 1u);
+  Client c(ep);
+  ASSERT_TRUE(c.Handshake());
+  EXPECT_EQ(ep.PortsOnBus(), 2u);
+  c.Close();
+  EXPECT_TRUE(ep.RunUntil([&] { return ep.PortsOnBus() == 1; }, 1s));
 }
 
 TEST(SocketcandServer, AlignedFramesAreWholeSixtyFourByteRecords) {
   ServerOptions o;
   o.raw_settle = Duration::zero();
   Endpoint ep(o);
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   std::vector<CanFrame> frames;
   for (std::uint32_t i = 0; i < 200; ++i)
@@ -215,24 +231,24 @@ TEST(SocketcandServer, AlignedFramesAreWholeSixtyFourByteRecords) {
 }
 
 // python-can reads the "< ok >" of rawmode with one recv() and compares it exactly: frames are
-// held for raw_settle after it has been written.
+// held for raw_settle after it has been written, and none is lost.
 TEST(SocketcandServer, FramesWaitUntilTheRawModeReplyHasSettled) {
   ServerOptions o = Compact();
   o.raw_settle = 150ms;
   Endpoint ep(o);
-  Client c(ep.port());
+  Client c(ep);
   EXPECT_EQ(c.RecvOnce(256), "< hi >");
   c.Send("< open can0 >");
   EXPECT_EQ(c.RecvOnce(256), "< ok >");
   c.Send("< rawmode >");
   EXPECT_EQ(c.RecvOnce(256), "< ok >");
-  const auto ok_at = std::chrono::steady_clock::now();
+  const TimePoint ok_at = ep.Now();
   ep.Send({Frame("123#01")});  // a frame right after the reply
+  EXPECT_EQ(c.Next(149ms), std::nullopt) << "held while the reply settles";
   const auto frame = c.Next(1s);
-  const auto waited = std::chrono::steady_clock::now() - ok_at;
   ASSERT_TRUE(frame.has_value());
   EXPECT_EQ(frame->substr(0, 12), "< frame 123 ");
-  EXPECT_GE(waited, 100ms) << "held until the reply has settled";
+  EXPECT_EQ(ep.Now() - ok_at, 150ms) << "released when raw_settle has passed";
 }
 
 // A client sending faster than the bus carries is not read while its port's queue is full, so
@@ -241,7 +257,7 @@ TEST(SocketcandServer, FastClientIsThrottledNotDropped) {
   ServerOptions o = Compact();
   o.max_tx_backlog = 64;
   Endpoint ep(o, {.name = "can0", .bitrate = 1'000'000, .tx_queue_capacity = 100});
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
   std::string burst;
   std::vector<CanFrame> expected;
@@ -262,20 +278,16 @@ TEST(SocketcandServer, SlowClientsOutputIsBounded) {
   ServerOptions o = Compact();
   o.max_output_bytes = 4096;
   Endpoint ep(o, {.name = "can0", .bitrate = 1'000'000, .paced = false, .tx_queue_capacity = 100'000});
-  Client c(ep.port(), 1024);
+  Client c(ep, 4096);  // a small socket buffer between server and client
   ASSERT_TRUE(c.Handshake());
   std::vector<CanFrame> frames;
   for (std::uint32_t i = 0; i < 20000; ++i)
     frames.push_back(
         CanFrame::Data(0x100, {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
   ep.Send(frames);
-  auto stats = ep.Stats();
-  for (int i = 0; i < 500 && stats.output_drops + stats.frames_to_clients < 20000; ++i) {
-    std::this_thread::sleep_for(10ms);
-    stats = ep.Stats();
-  }
+  ASSERT_TRUE(ep.RunUntil([&] { return ep.Stats().output_drops + ep.Stats().frames_to_clients == 20000; }));
+  const auto stats = ep.Stats();
   EXPECT_GT(stats.output_drops, 0u);
-  EXPECT_EQ(stats.output_drops + stats.frames_to_clients, 20000u);
   std::uint64_t received = 0;
   int last = -1;
   while (received < stats.frames_to_clients) {
@@ -304,58 +316,46 @@ TEST(SocketcandServer, FramesSentJustBeforeClosingStillReachTheBus) {
     expected.push_back(f);
   }
   {
-    Client c(ep.port());
+    Client c(ep);
     ASSERT_TRUE(c.Handshake());
     c.Send(burst);
   }
   EXPECT_EQ(ep.WaitReceived(300, 10s), expected);
-  for (int i = 0; i < 200 && ep.PortsOnBus() != 1; ++i)
-    std::this_thread::sleep_for(5ms);
-  EXPECT_EQ(ep.PortsOnBus(), 1u) << "the session leaves once its frames are on the wire";
+  EXPECT_TRUE(ep.RunUntil([&] { return ep.PortsOnBus() == 1; }, 1s))
+      << "the session leaves once its frames are on the wire";
 }
 
-// A port alone on a bus never gets an ACK (its frames stay queued): after drain_timeout the
-// session of a client that left is closed anyway.
+// A port alone on a bus never gets an ACK (its frames stay queued): drain_timeout after the client
+// left, its session is closed anyway.
 TEST(SocketcandServer, ALeftClientsSessionEndsAfterTheDrainTimeout) {
   ServerOptions o = Compact();
   o.drain_timeout = 200ms;
   Endpoint ep(o);
   ep.DetachCpp();
-  {
-    Client c(ep.port());
-    ASSERT_TRUE(c.Handshake());
-    c.Send("< send 123 1 01 >");
-    std::this_thread::sleep_for(20ms);
-  }
-  std::this_thread::sleep_for(100ms);
+  Client c(ep);
+  ASSERT_TRUE(c.Handshake());
+  c.Send("< send 123 1 01 >");
+  ep.RunFor(20ms);
+  c.Close();
+  ep.Settle();
+  const TimePoint left_at = ep.Now();
+  ep.RunFor(199ms);
   EXPECT_EQ(ep.PortsOnBus(), 1u) << "still draining";
-  for (int i = 0; i < 100 && ep.PortsOnBus() != 0; ++i)
-    std::this_thread::sleep_for(10ms);
-  EXPECT_EQ(ep.PortsOnBus(), 0u);
+  ASSERT_TRUE(ep.RunUntil([&] { return ep.PortsOnBus() == 0; }, 1s));
+  EXPECT_EQ(ep.Now() - left_at, 200ms);
 }
 
-TEST(SocketcandServer, ServeChecksTheBusAndDefaultsToPort29536) {
-  asio::io_context io;
-  AsioScheduler scheduler(io);
-  broker::Broker broker(scheduler);
-  broker.AddBus({.name = "can0"});
-  Server server(io, broker, scheduler);
-  EXPECT_THROW(server.Serve("can9", 0), std::invalid_argument);
-  std::uint16_t port = 0;
-  try {
-    port = server.Serve("can0");
-  } catch (const std::system_error& e) {
-    GTEST_SKIP() << "port 29536 is in use here: " << e.what();
-  }
-  EXPECT_EQ(port, kDefaultPort);
-  EXPECT_THROW(server.Serve("can0", 0), std::invalid_argument);
+TEST(SocketcandServer, OfferAndAdoptCheckTheBus) {
+  Endpoint ep(Compact());
+  EXPECT_THROW(ep.server().Offer("can9"), std::invalid_argument) << "not a bus of the broker";
+  EXPECT_THROW(ep.server().Offer("can0"), std::invalid_argument) << "already served";
 }
 
 TEST(SocketcandServer, StopClosesSessions) {
   Endpoint ep(Compact());
-  Client c(ep.port());
+  Client c(ep);
   ASSERT_TRUE(c.Handshake());
-  ep.OnIo([&] { ep.server().Stop(); });
+  ep.server().Stop();
   EXPECT_TRUE(c.ClosedByServer());
   EXPECT_EQ(ep.PortsOnBus(), 1u);
 }

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Helpers for the socketcand endpoint tests: a broker and a server running on an Asio
+/// @file Helpers for the socketcand endpoint's integration tests: a broker and a server on an Asio
 /// event loop in a background thread (real time, real TCP on loopback), and a blocking test
 /// client with timeouts.
 
@@ -83,7 +83,7 @@ class Endpoint {
     return OnIo([this] { return cpp_.frames; });
   }
   /// Waits until the C++ side has received `count` frames (or `timeout`).
-  std::vector<CanFrame> WaitReceived(std::size_t count, std::chrono::milliseconds timeout = 5s) {
+  std::vector<CanFrame> WaitReceived(std::size_t count, std::chrono::milliseconds timeout = 10s) {
     const auto end = std::chrono::steady_clock::now() + timeout;
     for (;;) {
       auto frames = Received();
@@ -143,7 +143,7 @@ class Client {
   }
 
   /// One recv() of up to `max` bytes, as python-can reads; nullopt on timeout, "" on EOF.
-  std::optional<std::string> RecvOnce(std::size_t max = 1024, std::chrono::milliseconds timeout = 3s) {
+  std::optional<std::string> RecvOnce(std::size_t max = 1024, std::chrono::milliseconds timeout = 10s) {
     pollfd p{fd_, POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(timeout.count())) <= 0) return std::nullopt;
     std::string buf(max, '\0');
@@ -154,7 +154,7 @@ class Client {
   }
 
   /// The next element "< ... >" (padding skipped); nullopt on timeout or EOF.
-  std::optional<std::string> Next(std::chrono::milliseconds timeout = 3s) {
+  std::optional<std::string> Next(std::chrono::milliseconds timeout = 10s) {
     const auto end = std::chrono::steady_clock::now() + timeout;
     for (;;) {
       const auto open = buffer_.find('<');
@@ -174,7 +174,7 @@ class Client {
   }
 
   /// True when the server closed the connection within `timeout` (data before EOF is skipped).
-  bool ClosedByServer(std::chrono::milliseconds timeout = 3s) {
+  bool ClosedByServer(std::chrono::milliseconds timeout = 10s) {
     const auto end = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < end) {
       const auto chunk = RecvOnce(4096, 100ms);

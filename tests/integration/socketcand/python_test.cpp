@@ -1,7 +1,7 @@
 // python-can (interface='socketcand', an off-the-shelf client nobody here wrote) on the endpoint,
 // over real TCP: frames the script sends reach a C++ port of the bus, and frames the C++ port
 // sends reach the script, with identifiers, formats, data and order intact (issue 4: "python-can
-// sends and receives through the socketcand endpoint"). Label `system`: it runs a Python process.
+// sends and receives through the socketcand endpoint"). Integration tier: a Python process, real TCP.
 //
 // The interpreter is the project's venv (scripts/python-env.sh, pinned python-can), or
 // $CANFLEET_SOCKETCAND_PYTHON to try another one (e.g. a venv with Debian's python-can 4.1.0).
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/unit/socketcand/socketcand_test_support.hpp"
+#include "tests/integration/socketcand/tcp_endpoint.hpp"
 
 namespace canfleet::socketcand {
 namespace {
@@ -97,7 +97,7 @@ TEST(PythonCan, SendsAndReceivesThroughTheSocketcandEndpoint) {
   Endpoint ep({}, {.name = "can0", .bitrate = 1'000'000, .tx_queue_capacity = 4096});
 
   const std::string command =
-      python + " " + CANFLEET_SOURCE_DIR + "/tests/unit/socketcand/python_socketcand_client.py --port " +
+      python + " " + CANFLEET_SOURCE_DIR + "/tests/integration/socketcand/python_socketcand_client.py --port " +
       std::to_string(ep.port()) + " --channel can0 --send " + std::to_string(kFromPython) + " --receive " +
       std::to_string(kFromCpp) + " 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");

@@ -1,0 +1,1 @@
+canfleet_fuzz_target(control_request DEPS canfleet_control)

@@ -1,0 +1,1 @@
+canfleet_fuzz_target(od_table DEPS canfleet_od_table)
