@@ -156,12 +156,12 @@ TEST_F(BrokerTelemetryTest, FaultsArePairedByTheirId) {
   const auto& injected = faults_[0].first;
   const auto& cleared = faults_[2].first;
   EXPECT_EQ(injected.fault_id, rule);
-  EXPECT_EQ(injected.action, telemetry::RuleAction::kInjected);
+  EXPECT_EQ(injected.action, telemetry::FaultAction::kInjected);
   EXPECT_EQ(injected.kind, "drop");
   EXPECT_EQ(injected.target_node, 5);
   EXPECT_EQ(injected.parameters, (std::vector<std::pair<std::string, std::string>>{{"cob_id", "0x705"}}));
   EXPECT_EQ(cleared.fault_id, rule);
-  EXPECT_EQ(cleared.action, telemetry::RuleAction::kCleared);
+  EXPECT_EQ(cleared.action, telemetry::FaultAction::kCleared);
   EXPECT_EQ(cleared.kind, "drop");
   EXPECT_EQ(cleared.parameters, injected.parameters);
   // Bus time: the broker's scheduler time line.

@@ -231,7 +231,7 @@ TEST(OrchestratorTelemetry, PublishesBusStatsPerBusAndFaults) {
   telemetry.UpdateBusStats(stats);
   telemetry.PublishFault({.bus = "ob0",
                           .fault_id = 7,
-                          .action = RuleAction::kInjected,
+                          .action = FaultAction::kInjected,
                           .kind = "drop",
                           .target_node = 5,
                           .parameters = {{"cob_id", "0x705"}},
