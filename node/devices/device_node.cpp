@@ -2,8 +2,8 @@
 
 #include <stdexcept>
 
-#include "node/canopen/storage/parameter_store.hpp"
 #include <string>
+#include "node/canopen/storage/parameter_store.hpp"
 
 namespace canfleet::devices {
 
@@ -128,7 +128,8 @@ void DeviceNode::ForwardSharedStorage() {
         sub.validators.push_back([primary, store, signature, range = *range](
                                      const canopen::SubObject& s, std::span<const std::uint8_t> data,
                                      canopen::Origin) {
-          if (data.size() != 4 || canopen::DecodeUnsignedLe(data) != signature) return canopen::SdoAbort::kNone;
+          if (data.size() != 4 || canopen::DecodeUnsignedLe(data) != signature)
+            return canopen::SdoAbort::kNone;
           for (const auto& group : canopen::ParameterGroups()) {
             const std::uint8_t group_sub = SubIndexOf(group.group);
             const bool in_command = s.sub_index == 1 || s.sub_index == group_sub ||

@@ -21,8 +21,8 @@ OdRef::OdRef(canopen::ObjectDictionary& od, std::uint16_t index, std::uint8_t su
   if (!sub_)
     throw std::logic_error("object " + FormatEntry(index, sub_index) + " missing from the dictionary");
   auto size = canopen::FixedSize(sub_->type);
-  if (!size || *size > 8 || !(canopen::IsSigned(sub_->type) || canopen::IsUnsigned(sub_->type) ||
-                               canopen::IsReal(sub_->type)))
+  if (!size || *size > 8 ||
+      !(canopen::IsSigned(sub_->type) || canopen::IsUnsigned(sub_->type) || canopen::IsReal(sub_->type)))
     throw std::logic_error("object " + FormatEntry(index, sub_index) + " is not a number");
 }
 
@@ -60,7 +60,8 @@ bool OdRef::SetNumber(double value) const {
   const std::size_t bits = 8 * canopen::FixedSize(sub_->type).value_or(8);
   const bool is_signed = canopen::IsSigned(sub_->type);
   const double lowest = is_signed ? -std::ldexp(1.0, static_cast<int>(bits) - 1) : 0.0;
-  const double highest = is_signed ? std::ldexp(1.0, static_cast<int>(bits) - 1) - 1 : std::ldexp(1.0, static_cast<int>(bits)) - 1;
+  const double highest = is_signed ? std::ldexp(1.0, static_cast<int>(bits) - 1) - 1
+                                   : std::ldexp(1.0, static_cast<int>(bits)) - 1;
   const double rounded = std::clamp(std::round(value), lowest, std::min(highest, 9.2e18));
   if (sub_->type == DataType::kBoolean) return Set(rounded != 0 ? 1 : 0);
   return Set(is_signed ? static_cast<std::int64_t>(rounded)

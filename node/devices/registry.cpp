@@ -138,7 +138,8 @@ std::unique_ptr<Device> MakeDevice(const DeviceSelection& selection) {
   }
   const DeviceInfo* info = FindDevice(selection.device);
   if (!info) {
-    throw std::invalid_argument("unknown device \"" + selection.device + "\" (known: " + KnownDeviceNames() + ")");
+    throw std::invalid_argument("unknown device \"" + selection.device + "\" (known: " + KnownDeviceNames() +
+                                ")");
   }
   return info->create(DeviceOptions{.eds = selection.eds, .ports = info->ports});
 }

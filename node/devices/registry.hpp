@@ -28,8 +28,8 @@ struct DeviceInfo {
   /// topology or the command line names none.
   std::uint8_t factory_node_id = 127;
   std::uint32_t factory_bit_rate_kbit = 125;
-  std::string_view eds_file_name;   ///< "quad-controller.eds", for messages and --write-eds
-  std::string_view (*eds_text)();   ///< the EDS generated from the variant's dictionary table
+  std::string_view eds_file_name;         ///< "quad-controller.eds", for messages and --write-eds
+  std::string_view (*eds_text)();         ///< the EDS generated from the variant's dictionary table
   void (*declare_signals)(SimulatedIo&);  ///< declares the simulated I/O into an empty SimulatedIo
   std::unique_ptr<Device> (*create)(const DeviceOptions&);
 };

@@ -152,7 +152,8 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
 int WriteEds(const std::string& device, const std::string& path) {
   const devices::DeviceInfo* variant = devices::FindDevice(device);
   if (variant == nullptr) {
-    throw std::invalid_argument("--write-eds needs --device NAME (known: " + devices::KnownDeviceNames() + ")");
+    throw std::invalid_argument("--write-eds needs --device NAME (known: " + devices::KnownDeviceNames() +
+                                ")");
   }
   const std::string_view text = variant->eds_text();
   if (path == "-") {
@@ -192,7 +193,8 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--list-devices", list, "list the device variants and exit");
-  app.add_option("--write-eds", write_eds, "write the --device variant's EDS to FILE (- for stdout) and exit");
+  app.add_option("--write-eds", write_eds,
+                 "write the --device variant's EDS to FILE (- for stdout) and exit");
   app.add_flag("--version", version, "print the version and exit");
   canfleet::node::TelemetrySettings telemetry;
   canfleet::node::AddTelemetryOptions(app, telemetry);
@@ -218,7 +220,8 @@ int main(int argc, char** argv) {
     if (buses.empty()) throw std::invalid_argument("give at least one --bus");
     if (node_ids.empty()) {
       const auto* variant = canfleet::devices::FindDevice(options.device);
-      if (variant == nullptr) throw std::invalid_argument("give --node-id (a generic node has no factory node-ID)");
+      if (variant == nullptr)
+        throw std::invalid_argument("give --node-id (a generic node has no factory node-ID)");
       node_ids.push_back(variant->factory_node_id);
     }
     for (const auto& b : buses)

@@ -16,7 +16,8 @@ canopen::ErrorEntry MakeFamilyEntry(std::uint16_t code, std::uint8_t description
 std::optional<canopen::CommErrorEncoding> FamilyErrorPolicy::Encode(const canopen::CommError& error) const {
   const ErrorConventions& c = conventions_;
   auto encoded = [&](std::uint16_t code, std::uint8_t description, std::uint8_t channel) {
-    return canopen::CommErrorEncoding{MakeFamilyEntry(code, description, channel), c.communication_behaviour_sub};
+    return canopen::CommErrorEncoding{MakeFamilyEntry(code, description, channel),
+                                      c.communication_behaviour_sub};
   };
   switch (error.kind) {
     case CommErrorKind::kHeartbeatTimeout:

@@ -96,10 +96,11 @@ TEST(PythonCan, SendsAndReceivesThroughTheSocketcandEndpoint) {
   constexpr int kFromCpp = 1500;  // ~96 kB of records: many 1024-byte reads on the client side
   Endpoint ep({}, {.name = "can0", .bitrate = 1'000'000, .tx_queue_capacity = 4096});
 
-  const std::string command =
-      python + " " + CANFLEET_SOURCE_DIR + "/tests/integration/socketcand/python_socketcand_client.py --port " +
-      std::to_string(ep.port()) + " --channel can0 --send " + std::to_string(kFromPython) + " --receive " +
-      std::to_string(kFromCpp) + " 2>&1";
+  const std::string command = python + " " + CANFLEET_SOURCE_DIR +
+                              "/tests/integration/socketcand/python_socketcand_client.py --port " +
+                              std::to_string(ep.port()) + " --channel can0 --send " +
+                              std::to_string(kFromPython) + " --receive " + std::to_string(kFromCpp) +
+                              " 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::vector<Rx> received;

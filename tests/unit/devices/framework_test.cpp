@@ -130,9 +130,9 @@ class TwoPortTest : public ::testing::Test {
   explicit TwoPortTest(std::filesystem::path state_dir = {}) : state_dir_(std::move(state_dir)) { Boot(); }
   void Boot() {
     node_.reset();
-    node_ = std::make_unique<DeviceNode>(std::make_unique<TwoPortDevice>(), scheduler_,
-                                         std::vector<BusPort*>{&port1_, &port2_},
-                                         NodeSettings{{PortSettings{3, 4}, PortSettings{4, 4}}, state_dir_, {}, {}});
+    node_ = std::make_unique<DeviceNode>(
+        std::make_unique<TwoPortDevice>(), scheduler_, std::vector<BusPort*>{&port1_, &port2_},
+        NodeSettings{{PortSettings{3, 4}, PortSettings{4, 4}}, state_dir_, {}, {}});
     node_->Start();
     can1_.Clear();
     can2_.Clear();
@@ -153,7 +153,7 @@ TEST_F(TwoPortTest, ApplicationObjectsAreOneObjectAndRulesApplyOnBothPorts) {
   EXPECT_TRUE(node_->od(1).IsBorrowed(0x2000));
   EXPECT_EQ(node_->od(1).Find(0x2000, 0), node_->od(0).Find(0x2000, 0));  // one object, not a copy
   EXPECT_FALSE(node_->od(1).IsBorrowed(0x1017));                          // communication: per port
-  can2_.Send("604#2B00200008000000");  // port 2, node 4: 2000h = 8
+  can2_.Send("604#2B00200008000000");                                     // port 2, node 4: 2000h = 8
   EXPECT_EQ(can2_.Next(), "584#6000200000000000");
   EXPECT_EQ(device().changes, 1);
   can1_.Send("603#4000200000000000");
@@ -286,7 +286,8 @@ TEST(DevicePortTest, ADeviceSeesFramesFirstMutesItsStackAndSendsItself) {
   LoopbackBus bus;
   LoopbackPort& raw = bus.Attach("node");
   canfleet::test::BusProbe can{bus, "master"};
-  DeviceNode node(std::make_unique<HookDevice>(), scheduler, {&raw}, NodeSettings{{PortSettings{5, 4}}, {}, {}, {}});
+  DeviceNode node(std::make_unique<HookDevice>(), scheduler, {&raw},
+                  NodeSettings{{PortSettings{5, 4}}, {}, {}, {}});
   auto& device = static_cast<HookDevice&>(node.device());
   node.Start();
   EXPECT_EQ(can.Next(), "705#00");  // boot-up
@@ -298,7 +299,8 @@ TEST(DevicePortTest, ADeviceSeesFramesFirstMutesItsStackAndSendsItself) {
   device.port->SetMuted(true);      // asleep: the stack's heartbeats stay off the bus
   scheduler.Advance(300ms);
   EXPECT_EQ(can.Count(), 0u);
-  EXPECT_TRUE(device.port->SendFromDevice(CanFrame::Data(0x000, {0x01, 0x00})));  // the device's own NMT Start
+  EXPECT_TRUE(
+      device.port->SendFromDevice(CanFrame::Data(0x000, {0x01, 0x00})));  // the device's own NMT Start
   EXPECT_EQ(can.Next(), "000#0100");
   device.port->SetMuted(false);
   scheduler.Advance(100ms);
@@ -315,8 +317,10 @@ namespace {
 // are numbers to the blocks; integers take numbers rounded and saturated, never wrapped.
 TEST(OdRefTest, RealsAndIntegersAsNumbers) {
   canopen::ObjectDictionary od;
-  od.AddVar(0x5020, "Power Supply FV", canopen::DataType::kReal32, canopen::Access::kRo, canopen::EncodeLe(24.5f));
-  od.AddVar(0x2460, "PID Output FV", canopen::DataType::kInteger16, canopen::Access::kRo, canopen::EncodeLe<std::int16_t>(0));
+  od.AddVar(0x5020, "Power Supply FV", canopen::DataType::kReal32, canopen::Access::kRo,
+            canopen::EncodeLe(24.5f));
+  od.AddVar(0x2460, "PID Output FV", canopen::DataType::kInteger16, canopen::Access::kRo,
+            canopen::EncodeLe<std::int16_t>(0));
   od.AddVar(0x2000, "Level", canopen::DataType::kUnsigned8, canopen::Access::kRo, {0});
   const OdRef supply(od, 0x5020, 0);
   const OdRef pid(od, 0x2460, 0);
@@ -338,7 +342,8 @@ TEST(OdRefTest, RealsAndIntegersAsNumbers) {
   EXPECT_TRUE(level.SetNumber(-4));
   EXPECT_EQ(level.Get(), 0);
   EXPECT_FALSE(level.SetNumber(std::nan("")));
-  od.AddVar(0x1008, "Name", canopen::DataType::kVisibleString, canopen::Access::kConst, canopen::ToBytes("x"));
+  od.AddVar(0x1008, "Name", canopen::DataType::kVisibleString, canopen::Access::kConst,
+            canopen::ToBytes("x"));
   EXPECT_THROW(OdRef(od, 0x1008, 0), std::logic_error);
 }
 

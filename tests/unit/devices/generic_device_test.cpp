@@ -96,13 +96,15 @@ TEST(DeviceRegistryTest, ListsTheQuadAndExplainsBadSelections) {
   const auto line_start = list.find("quad-controller ");
   ASSERT_NE(line_start, std::string::npos) << list;
   const std::string line = list.substr(line_start, list.find('\n', line_start) - line_start);
-  EXPECT_NE(line.find(" 1 port   id 127 @ 125 kbit/s   Axiomatic CANopen Quad Controller AX020506"), std::string::npos)
+  EXPECT_NE(line.find(" 1 port   id 127 @ 125 kbit/s   Axiomatic CANopen Quad Controller AX020506"),
+            std::string::npos)
       << line;
   try {
     MakeDevice({"toaster", {}});
     ADD_FAILURE();
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("unknown device \"toaster\" (known: quad-controller, ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("unknown device \"toaster\" (known: quad-controller, ", 0), 0u)
+        << e.what();
   }
   EXPECT_THROW(MakeDevice({}), std::invalid_argument);
   EXPECT_EQ(MakeDevice({"quad-controller", {}})->Name(), "quad-controller");
