@@ -3,7 +3,7 @@
 objects read their EDS defaults, and what its RPDO and device-specific fault look like).
 
 The variant list of canfleet-node is node/devices/registry.cpp (`canfleet-node --list-devices`):
-today `quad-controller`, plus the generic node (`--eds FILE` without `--device`), which runs any
+today `quad-controller` and `datalogger-tc-analog`, plus the generic node (`--eds FILE` without `--device`), which runs any
 EDS on the plain CiA 301 stack; it is checked with two EDSs.
 """
 from __future__ import annotations
@@ -55,6 +55,12 @@ class Variant:
     device_faults: List[DeviceFault] = field(default_factory=list)
     # Objects a master may read but that have no data to give (read aborts that are correct).
     no_data: Callable[[int, int], bool] = lambda index, sub: index == 0x1003 and sub > 0
+    # Measured objects that no input can make read their EDS default without raising a fault of
+    # the device (read and size checked, the value not compared).
+    measured: Callable[[int, int], bool] = lambda index, sub: False
+    # CAN ports: port 1 is on the suite's bus; further ports are attached to buses of their own
+    # (harness.Fleet.port_bus), so a two-port device runs whole while python-canopen checks port 1.
+    ports: int = 1
 
     def node_args(self) -> List[str]:
         if self.device:
@@ -142,4 +148,164 @@ CONFORMANCE_IO = Variant(
     device_faults=DIO16.device_faults,
 )
 
-VARIANTS = [QUAD, DIO16, CONFORMANCE_IO]
+# The data logger AX181001 (UMAX181001 V1.01), two CAN ports sharing the application objects (§3):
+# port 1 is checked on the suite's bus, port 2 runs on a bus of its own (harness.Fleet.port_bus).
+# Its TC limits 2170h-2173h default to 0 and trip at room temperature (§3.4.22-3.4.26, the
+# variant's README "Factory thresholds"): the suite keeps its thermocouples and cold junction at
+# 0.0 C, where 6100h/6130h/2161h/2162h read their EDS default 0 and no limit trips (a warning is
+# FV > limit or FV < limit), so every default is still checked as the EDS gives it. The analog
+# inputs at 0 mV read 7100h = 7130h = 0 (span checks 2110h are off by default, §3.4.8).
+DATALOGGER = Variant(
+    id="datalogger-tc-analog",
+    name="datalogger-10",
+    device="datalogger-tc-analog",
+    eds=BUILD / "node/devices/datalogger_tc_analog/datalogger-tc-analog.eds",
+    node_id=10,
+    ports=2,
+    default_io=[f"TC{n}.temperature_C=0" for n in range(1, 5)] + ["CJ.temperature_C=0", "TEMP.temperature_C=0"]
+    + [f"AIN{n}.voltage_mV=0" for n in range(1, 11)],
+    # §1.8 5020h is the measured supply (REAL32, EDS default 0): 0 V would be an undervoltage fault
+    # (§3.4.70 5022h = 8 V, 40003000h), so the node runs at its simulated 24 V.
+    measured=lambda index, sub: index == 0x5020,
+    # §3.2.15 default TPDO1: 7100h sub 1-4, the AI field values: volts with 2102h = 3 decimal
+    # digits (the default for the default voltage sensor type 6110h = 40, Table 11), i.e. mV.
+    pdo_io=[("AIN1.voltage_mV", "1200"), ("AIN2.voltage_mV", "800"), ("AIN3.voltage_mV", "400"),
+            ("AIN4.voltage_mV", "1600")],
+    tpdo_expected={(0x7100, 1): 1200, (0x7100, 2): 800, (0x7100, 3): 400, (0x7100, 4): 1600},
+    # §3.2.14 default RPDO1: 2500h sub 1-4, the extra received process values (INTEGER16).
+    rpdo_values={(0x2500, 1): 100, (0x2500, 2): -200, (0x2500, 3): 3000, (0x2500, 4): -32768},
+    # §3.2.4 Table 26: 80nn8130h, EMCY data channel nn then description 80h; 1001h bit 0 only.
+    hb_register=0x01,
+    hb_data=lambda node: bytes([node, 0x80, 0, 0, 0]),
+    hb_history=lambda node: (0x80 << 24) | (node << 16) | 0x8130,
+    device_faults=[
+        DeviceFault(
+            what="TC1 open circuit (UMAX181001 §1.2, Table 26: 1010F002h)",
+            inject=_io_set("TC1.open", "true"), clear=_io_set("TC1.open", "false"),
+            code=0xF002, register=0x01, data=bytes([0x10, 0x10, 0, 0, 0]), history=0x1010F002),
+        DeviceFault(
+            what="supply overvoltage (UMAX181001 §1.8, §3.4.71 5023h = 35 V, Table 26: 20003000h)",
+            inject=_io_set("VPS.voltage_V", "40"), clear=_io_set("VPS.voltage_V", "24"),
+            code=0x3000, register=0x01, data=bytes([0x00, 0x20, 0, 0, 0]), history=0x20003000),
+    ],
+)
+
+# The family's error conventions (node/devices/family/family_error_policy.hpp): 1003h entry
+# description << 24 | channel << 16 | code, EMCY data bytes channel then description, 1001h bit 0.
+def _family_hb_data(node: int) -> bytes:
+    return bytes([node, 0x80, 0, 0, 0])
+
+
+def _family_hb_history(node: int) -> int:
+    return (0x80 << 24) | (node << 16) | 0x8130
+
+
+# Valve controller AX020411A (UMAX020411A V1.0.2). Its universal inputs at 0 V would raise the
+# span fault 40nnF001h after 1 s (2110h TRUE, span start 7148h = 200 mV, §3.3.14, §3.4.8: the
+# variant's README "Factory defaults and faults"), and a 0 V supply 40003000h (5021h TRUE, §1.10):
+# those measurements run at the simulated 2500 mV / 24 V and only their size is checked. The
+# processor temperature at 0 C reads 5030h = 0.0 (§3.4.104; no under-temperature fault, §4).
+VALVE = Variant(
+    id="valve-12in12out",
+    name="valve-34",
+    device="valve-12in12out",
+    eds=BUILD / "node/devices/valve_12in12out/valve-12in12out.eds",
+    node_id=34,
+    default_io=["TEMP.temperature_C=0"],
+    measured=lambda index, sub: index == 0x5020 or (index in (0x7100, 0x7130) and 1 <= sub <= 7),
+    # §3.2.15 default TPDO1: 7100h sub 1-4, UI1-4 field values in mV at the default 0-5 V type
+    # (6110h = 40, §3.3.2, Table 10).
+    pdo_io=[("UI1.voltage_mV", "1200"), ("UI2.voltage_mV", "800"), ("UI3.voltage_mV", "400"),
+            ("UI4.voltage_mV", "1600")],
+    tpdo_expected={(0x7100, 1): 1200, (0x7100, 2): 800, (0x7100, 3): 400, (0x7100, 4): 1600},
+    # §3.2.14 default RPDO1: 7300h sub 1-4, "CANopen message 1-4", which OUT1-4 follow by default
+    # (2340h = 1, 2341h = n, §3.4.34/35), 300..1500 onto 300..1500 mA (7320h-7323h, Table 14).
+    rpdo_values={(0x7300, 1): 1000, (0x7300, 2): 800, (0x7300, 3): 600, (0x7300, 4): 400},
+    rpdo_outputs={"OUT1.current_mA": "1000", "OUT4.current_mA": "400"},
+    # §3.2.4 Table 33: 80nn8130h; the family's EMCY data (channel, description); 1001h bit 0 only.
+    hb_register=0x01,
+    hb_data=_family_hb_data,
+    hb_history=_family_hb_history,
+    device_faults=[
+        DeviceFault(
+            what="UI1 below its span start (§1.3, §3.4.8 7148h = 200 mV, 2112h 1 s; Table 33: 4001F001h)",
+            inject=_io_set("UI1.voltage_mV", "100"), clear=_io_set("UI1.voltage_mV", "2500"),
+            code=0xF001, register=0x01, data=bytes([0x01, 0x40, 0, 0, 0]), history=0x4001F001),
+        DeviceFault(
+            what="supply overvoltage (§1.10, §3.4.102 5023h = 35 V; Table 33: 20003000h)",
+            inject=_io_set("VPS.voltage_V", "40"), clear=_io_set("VPS.voltage_V", "24"),
+            code=0x3000, register=0x01, data=bytes([0x00, 0x20, 0, 0, 0]), history=0x20003000),
+    ],
+)
+
+# Encoder input dual valve controller AX023241 (manual v1.1; no EMCY table: the family's codes,
+# the variant's README "EMCY codes"). A 0 V supply is an undervoltage fault (5050h bit 0, 5041h.3
+# = 9.0 V, 1.5): 5020h and the supply's fault-detection values 5040h.2/.3 run at the simulated
+# 24 V and only their size is checked; the processor temperature at 0 C reads 5030h = 5040h.1 = 0.
+ENCODER = Variant(
+    id="encoder-dual-valve",
+    name="encoder-35",
+    device="encoder-dual-valve",
+    eds=BUILD / "node/devices/encoder_dual_valve/encoder-dual-valve.eds",
+    node_id=35,
+    default_io=["TEMP.temperature_C=0"],
+    measured=lambda index, sub: index == 0x5020 or (index == 0x5040 and sub in (2, 3)),
+    # C3-1.2.24 default TPDO1: 7100h sub 1-2. Both inputs decode the quadrature encoder (6110h =
+    # 10002, 1.2.1) as a count (2100h = 0): 3410h (1.0) x steps, steps = the shaft's edges.
+    pdo_io=[("ENC.position_counts", "1234")],
+    tpdo_expected={(0x7100, 1): 1234},
+    # C3-1.2.16 default RPDO1: 7300h sub 1-2, which OUT1-2 follow (control source 1, number n,
+    # 1.3 Table 7), 0..5000 onto 0..5000 mA (7320h-7323h).
+    rpdo_values={(0x7300, 1): 1000, (0x7300, 2): 800},
+    rpdo_outputs={"OUT1.current_mA": "1000", "OUT2.current_mA": "800"},
+    hb_register=0x01,
+    hb_data=_family_hb_data,
+    hb_history=_family_hb_history,
+    device_faults=[
+        DeviceFault(
+            what="supply undervoltage (1.5, 5041h.3 = 9.0 V after 5051h.2 x 100 ms; README: 40003000h)",
+            inject=_io_set("VPS.voltage_V", "8"), clear=_io_set("VPS.voltage_V", "24"),
+            code=0x3000, register=0x01, data=bytes([0x00, 0x40, 0, 0, 0]), history=0x40003000),
+        DeviceFault(
+            what="processor over-temperature (1.5, 5041h.1 = 110.0 C; README: 20004200h)",
+            inject=_io_set("TEMP.temperature_C", "120"), clear=_io_set("TEMP.temperature_C", "0"),
+            code=0x4200, register=0x01, data=bytes([0x00, 0x20, 0, 0, 0]), history=0x20004200),
+    ],
+)
+
+# Power supply PS-24-24-350W-CAN (UMAX080311 V1.0.3, CiA 453). A 0 V input is an input failure
+# (6114h = 9 V, §1.2.3): 6113h runs at the simulated 24 V and only its size is checked; the unit at
+# 0 C reads 6020h = 0 (§2.3.4) and trips no temperature threshold (6021h/6022h).
+POWER_SUPPLY = Variant(
+    id="power-supply-24v-350w",
+    name="psu-36",
+    device="power-supply-24v-350w",
+    eds=BUILD / "node/devices/power_supply_24v_350w/power-supply-24v-350w.eds",
+    node_id=36,
+    default_io=["TEMP.temperature_C=0"],
+    measured=lambda index, sub: index == 0x6113 and sub == 1,
+    # §2.2.15 default TPDO2: 6204h.1 output voltage (off: 0 mV), 6113h.1 input voltage in mV (the
+    # filtered measurement, README choice 9).
+    pdo_io=[("VIN.voltage_V", "20")],
+    tpdo_expected={(0x6113, 1): 20000, (0x6204, 1): 0},
+    # §2.2.14 default RPDO1: 6200h.2 on/off (FDh = on, §2.3.16), 6200h.3 quit failure (FFh = no
+    # action); with 6010h.1 = FFh the latest command wins (§1.2.1 Table 1): the output goes on.
+    rpdo_values={(0x6200, 2): 0xFD, (0x6200, 3): 0xFF},
+    rpdo_outputs={"PS.output_on": "true"},
+    # §2.2.4 Table 9: 80nn8130h, family EMCY data; 1001h bit 0 only (§2.2.2).
+    hb_register=0x01,
+    hb_data=_family_hb_data,
+    hb_history=_family_hb_history,
+    device_faults=[
+        DeviceFault(
+            what="input undervoltage (§1.2.3, 6114h = 9 V, 6119h.1 + 6013h.1 delays; Table 9: 0000FF04h)",
+            inject=_io_set("VIN.voltage_V", "8"), clear=_io_set("VIN.voltage_V", "24"),
+            code=0xFF04, register=0x01, data=bytes(5), history=0x0000FF04),
+        DeviceFault(
+            what="input overvoltage (§1.2.3, 6115h = 48 V, README choice 13; Table 9: 0000FF04h)",
+            inject=_io_set("VIN.voltage_V", "50"), clear=_io_set("VIN.voltage_V", "24"),
+            code=0xFF04, register=0x01, data=bytes(5), history=0x0000FF04),
+    ],
+)
+
+VARIANTS = [QUAD, DIO16, CONFORMANCE_IO, DATALOGGER, VALVE, ENCODER, POWER_SUPPLY]
