@@ -4,7 +4,7 @@
 #   scripts/fuzz.sh [SECONDS]                   every target for SECONDS (default 15): CI's smoke run
 #   scripts/fuzz.sh --minutes N [TARGET...]     long mode: N minutes per target (default: all), then
 #                                               the figures go into fuzz/README.md and the minimised
-#                                               corpus into fuzz/corpus/<target>/
+#                                               corpus into fuzz/corpus/<target>/ (N = 0: only that)
 #
 # Where inputs live (see fuzz/README.md):
 #   fuzz/seeds/<target>/    hand-written seeds, each one a case someone meant
@@ -43,6 +43,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -n "$minutes" ] && seconds=$((minutes * 60))
+[ "$minutes" = 0 ] && seconds=0 # only re-minimise (below); never run libFuzzer with 0 = no limit
 
 cache=${CANFLEET_FUZZ_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/canfleet-fuzz}
 mkdir -p "$cache"
@@ -75,6 +76,7 @@ figures=build-fuzz/figures.tsv
 : >"$figures"
 failed=()
 for name in "${names[@]}"; do
+  [ "$seconds" = 0 ] && break
   bin=build-fuzz/fuzz/fuzz_$name
   corpus=$cache/$name
   mkdir -p "$corpus"
@@ -106,31 +108,51 @@ done
 
 [ -n "$minutes" ] || exit 0
 
-# Long mode: the repository's minimised corpus. Merging into a folder that already holds the seeds
-# keeps only inputs that add coverage beyond them; the seeds' copies are then removed again.
+# Long mode: the repository's minimised corpus, kept small: an edge cover. libFuzzer's merge runs
+# the seeds first, then every other input from the smallest up, and its control file lists for each
+# input the edges no earlier input reached ("COV i edge..."); the inputs beyond the seeds that reach
+# one are kept. (-merge=1's own choice keeps every input with a new feature, i.e. hit-count bucket:
+# ten times more files for the same edges.)
+minimise() { # TARGET: rewrites fuzz/corpus/TARGET, prints the number of files kept
+  local name=$1 bin=build-fuzz/fuzz/fuzz_$1 work=build-fuzz/merge/$1 ctl=build-fuzz/merge/$1.ctl
+  rm -rf "$work" "$ctl"
+  mkdir -p "$work" "build-fuzz/merge/$name.new"
+  [ -d "fuzz/seeds/$name" ] && cp "fuzz/seeds/$name"/* "$work"/
+  local from=("$cache/$name")
+  [ -d "fuzz/corpus/$name" ] && from+=("fuzz/corpus/$name")
+  "$bin" -merge=1 -timeout=25 -merge_control_file="$ctl" "$work" "${from[@]}" 2>"build-fuzz/merge_$name.log" || {
+    tail -30 "build-fuzz/merge_$name.log" >&2
+    return 1
+  }
+  rm -rf "build-fuzz/merge/$name.new"
+  mkdir -p "build-fuzz/merge/$name.new"
+  python3 - "$ctl" "build-fuzz/merge/$name.new" <<'PY'
+import hashlib, shutil, sys
+lines = open(sys.argv[1], errors="replace").read().splitlines()
+count, first = int(lines[0]), int(lines[1])
+paths = lines[2:2 + count]
+for line in lines[2 + count:]:
+    parts = line.split()
+    if len(parts) > 2 and parts[0] == "COV" and int(parts[1]) >= first:
+        data = open(paths[int(parts[1])], "rb").read()
+        open(sys.argv[2] + "/" + hashlib.sha1(data).hexdigest(), "wb").write(data)
+PY
+  rm -rf "fuzz/corpus/$name"
+  mv "build-fuzz/merge/$name.new" "fuzz/corpus/$name"
+  find "fuzz/corpus/$name" -type f | wc -l
+}
+
+if [ "$minutes" = 0 ]; then # --minutes 0: only re-minimise (after a change of the cover rule)
+  for name in "${names[@]}"; do
+    echo "fuzz: $name minimised corpus: $(minimise "$name") files in fuzz/corpus/$name"
+  done
+  exit 0
+fi
+
 for name in "${names[@]}"; do
   case " ${failed[*]} " in *" $name "*) continue ;; esac # a failed target's corpus waits for its fix
-  bin=build-fuzz/fuzz/fuzz_$name
-  work=build-fuzz/merge/$name
-  rm -rf "$work"
-  mkdir -p "$work"
-  [ -d "fuzz/seeds/$name" ] && cp "fuzz/seeds/$name"/* "$work"/
-  from=("$cache/$name")
-  [ -d "fuzz/corpus/$name" ] && from+=("fuzz/corpus/$name")
-  "$bin" -merge=1 -timeout=25 "$work" "${from[@]}" 2>"build-fuzz/merge_$name.log" || {
-    tail -30 "build-fuzz/merge_$name.log"
-    exit 1
-  }
-  if [ -d "fuzz/seeds/$name" ]; then
-    for s in "fuzz/seeds/$name"/*; do
-      rm -f "$work/$(basename "$s")"
-    done
-  fi
-  rm -rf "fuzz/corpus/$name"
-  mkdir -p "fuzz/corpus/$name"
-  find "$work" -type f -exec cp {} "fuzz/corpus/$name/" \;
-  kept=$(find "fuzz/corpus/$name" -type f | wc -l)
-  size=$(du -sk "fuzz/corpus/$name" | cut -f1)
+  kept=$(minimise "$name") || exit 1
+  size=$(du -sk --apparent-size "fuzz/corpus/$name" | cut -f1)
   echo "fuzz: $name minimised corpus: $kept files, ${size} KiB in fuzz/corpus/$name"
   sed -i "s|^$name\t.*|&\t$kept|" "$figures"
 done
