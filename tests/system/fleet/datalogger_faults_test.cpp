@@ -313,8 +313,16 @@ TEST_F(DataLoggerFleetTest, BusOffOfOnePortLeavesTheOtherPortsTrafficUnaffected)
 // warning (600.0 C); the fault is the device's, so both ports report it (README "Two ports");
 // 1029h sub 3 is 1 (no state change) on both.
 TEST_F(DataLoggerFleetTest, ThermocoupleOverItsWarningThresholdIsReportedOnBothPorts) {
+  // The log may already hold an F011h line from SetUp (the first conversion against the factory
+  // limits): the new EMCY is the one counted after the input changed.
+  const std::uint64_t emcys_before[] = {PortEmcyCount(kCan1), PortEmcyCount(kCan2)};
   ASSERT_TRUE(Cli({"io", "set", kLogger, "TC1.temperature_C", "650"}));
   for (const int port : {kCan1, kCan2}) {
+    EXPECT_TRUE(
+        WaitUntil([&] { return PortEmcyCount(port) > emcys_before[port] && PortLastEmcy(port) == 0xF011u; },
+                  kProductPatience))
+        << port << "\n"
+        << fleet().Log();
     EXPECT_TRUE(WaitLog(LoggerEmcy(0xF011, 0x01, "10 02 00 00 00", port))) << fleet().Log();
     EXPECT_EQ(SdoOn(port, "0x1003", 1, "u32"), 0x0210F011u) << port;
     EXPECT_EQ(SdoOn(port, "0x1001", 0, "u8"), 0x01u) << port;

@@ -6,6 +6,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/ioctl.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -123,6 +124,7 @@ ChildProcess::ChildProcess(std::vector<std::string> argv, std::string stderr_pat
   ::fcntl(stdout_fd_, F_SETFL, ::fcntl(stdout_fd_, F_GETFL) | O_NONBLOCK);
   // A child that exits must not kill us with SIGPIPE when we write to its stdin.
   ::signal(SIGPIPE, SIG_IGN);
+  reader_ = std::thread([this] { ReadStdout(); });
 }
 
 ChildProcess::~ChildProcess() {
@@ -130,6 +132,7 @@ ChildProcess::~ChildProcess() {
     ::kill(pid_, SIGKILL);
     Wait(std::chrono::seconds(30));
   }
+  StopReader();
   if (stdin_fd_ >= 0) ::close(stdin_fd_);
   if (stdout_fd_ >= 0) ::close(stdout_fd_);
 }
@@ -147,34 +150,77 @@ void ChildProcess::WriteLine(const std::string& line) {
   }
 }
 
-bool ChildProcess::ReadSome(int timeout_ms) {
-  pollfd p{stdout_fd_, POLLIN, 0};
-  if (::poll(&p, 1, timeout_ms) <= 0) return true;
+void ChildProcess::ReadStdout() {
+  std::string partial;
   char buf[65536];
   for (;;) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return;
+    }
+    // A bounded poll, so StopReader() is noticed even while the child (or a grandchild holding
+    // the pipe) stays silent.
+    pollfd p{stdout_fd_, POLLIN, 0};
+    if (::poll(&p, 1, 50) <= 0) continue;
+    {
+      std::lock_guard lock(mutex_);
+      in_flight_ = true;
+    }
     const ssize_t n = ::read(stdout_fd_, buf, sizeof buf);
-    if (n == 0) return false;  // closed
-    if (n < 0) return errno == EAGAIN || errno == EINTR;
-    partial_.append(buf, static_cast<std::size_t>(n));
+    std::lock_guard lock(mutex_);
+    in_flight_ = false;
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
+      new_lines_.notify_all();
+      continue;
+    }
+    if (n <= 0) {
+      stdout_closed_ = true;
+      new_lines_.notify_all();
+      return;
+    }
+    partial.append(buf, static_cast<std::size_t>(n));
     std::size_t start = 0;
-    for (std::size_t nl; (nl = partial_.find('\n', start)) != std::string::npos; start = nl + 1)
-      lines_.push_back(partial_.substr(start, nl - start));
-    partial_.erase(0, start);
+    for (std::size_t nl; (nl = partial.find('\n', start)) != std::string::npos; start = nl + 1)
+      lines_.push_back(partial.substr(start, nl - start));
+    partial.erase(0, start);
+    new_lines_.notify_all();
   }
 }
 
+void ChildProcess::StopReader() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  if (reader_.joinable()) reader_.join();
+}
+
 void ChildProcess::Poll() {
-  ReadSome(0);
+  // Bounded: a child writing without pause would otherwise keep the caller here.
+  const auto deadline = Clock::now() + std::chrono::seconds(2);
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    int pending = 0;
+    if (::ioctl(stdout_fd_, FIONREAD, &pending) != 0) pending = 0;
+    if (stdout_closed_ || (!in_flight_ && pending == 0) || Clock::now() >= deadline) return;
+    new_lines_.wait_for(lock, std::chrono::milliseconds(10));
+  }
+}
+
+std::vector<std::string> ChildProcess::Lines() const {
+  std::lock_guard lock(mutex_);
+  return lines_;
 }
 
 std::optional<std::string> ChildProcess::WaitForLine(const std::function<bool(const std::string&)>& match,
                                                      std::chrono::milliseconds timeout) {
   const auto deadline = Clock::now() + timeout;
+  std::unique_lock lock(mutex_);
   for (;;) {
     for (; scanned_ < lines_.size(); ++scanned_)
       if (match(lines_[scanned_])) return lines_[scanned_++];
-    if (Clock::now() >= deadline) return std::nullopt;
-    if (!ReadSome(std::min(RemainingMs(deadline), 50)) && scanned_ == lines_.size()) return std::nullopt;
+    if (stdout_closed_ || Clock::now() >= deadline) return std::nullopt;
+    new_lines_.wait_until(lock, deadline);
   }
 }
 

@@ -1,14 +1,17 @@
 #pragma once
 /// @file System-test helpers: a child process with its stdin and stdout on pipes (stdout read
-/// line by line), free TCP ports, short temporary directories, and polling a condition with a
-/// generous deadline (never a fixed sleep, never a short bound).
+/// line by line, drained continuously), free TCP ports, short temporary directories, and polling a condition
+/// with a generous deadline (never a fixed sleep, never a short bound).
 
 #include <sys/types.h>
 
 #include <chrono>
+#include <condition_variable>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace canfleet::system_test {
@@ -41,6 +44,11 @@ class TempDir {
 
 /// A child process. stdin and stdout are pipes; stderr goes to `stderr_path` (appended) so a
 /// failing test can show the child's log. Destruction kills (SIGKILL) and reaps it.
+///
+/// A thread of its own reads stdout as the child writes it. A child whose stdout is read only when
+/// the test looks would block in write() once the pipe's 64 KiB are full: an orchestrator logging
+/// at debug level, polled by a test through the CLI, stopped answering that way (every request it
+/// logs fills the pipe a little) until the test's next look at its output.
 class ChildProcess {
  public:
   ChildProcess(std::vector<std::string> argv, std::string stderr_path);
@@ -59,9 +67,10 @@ class ChildProcess {
                                          std::chrono::milliseconds timeout = kPatience);
   std::optional<std::string> WaitForPrefix(const std::string& prefix,
                                            std::chrono::milliseconds timeout = kPatience);
-  /// Every stdout line read so far.
-  const std::vector<std::string>& Lines() const { return lines_; }
-  /// Reads whatever stdout has ready now.
+  /// Every stdout line read so far (a copy: the reader thread appends to the original).
+  std::vector<std::string> Lines() const;
+  /// Returns once what stdout has ready now is in Lines() (the reader thread drains it anyway;
+  /// this is for a caller that wants the output written so far, e.g. after the child exited).
   void Poll();
 
   void Signal(int signal);
@@ -73,16 +82,24 @@ class ChildProcess {
   std::string Log() const;
 
  private:
-  bool ReadSome(int timeout_ms);
+  /// The reader thread: appends stdout's lines until it closes or Stop().
+  void ReadStdout();
+  void StopReader();
 
   pid_t pid_ = -1;
   int stdin_fd_ = -1;
   int stdout_fd_ = -1;
   std::string stderr_path_;
-  std::string partial_;
-  std::vector<std::string> lines_;
-  std::size_t scanned_ = 0;  ///< lines already offered to WaitForLine's matcher
   std::optional<int> status_;
+
+  mutable std::mutex mutex_;           ///< guards the members below
+  std::condition_variable new_lines_;  ///< a line arrived, or stdout closed
+  std::vector<std::string> lines_;
+  bool stdout_closed_ = false;
+  bool stopping_ = false;
+  bool in_flight_ = false;   ///< the reader holds bytes it has not appended yet
+  std::size_t scanned_ = 0;  ///< lines already offered to WaitForLine's matcher
+  std::thread reader_;
 };
 
 /// A connected stream socket to a broker endpoint (tcp://... or unix://...), for tests that speak
