@@ -158,7 +158,14 @@ void ScenarioRunner::Anchored(int step, TimePoint anchor) {
       e.opened = open;
       OpenWindow(e);
     });
-    e.open_timer->StartAt(std::max(open, scheduler_.Now()));
+    // A window already due opens now, not on a timer: the frames that follow the anchor's in the
+    // same delivery (an error reset right after the EMCY it resets) must find it open.
+    if (open <= scheduler_.Now()) {
+      e.opened = open;
+      OpenWindow(e);
+    } else {
+      e.open_timer->StartAt(open);
+    }
   }
 }
 
@@ -296,11 +303,16 @@ void ScenarioRunner::Finish(Expectation& e) {
 }
 
 void ScenarioRunner::Frame(const std::string& bus, const CanFrame& frame, TimePoint time) {
-  for (auto& ptr : expects_) {
-    Expectation& e = *ptr;
-    if (!e.opened || e.reported) continue;
-    e.judge->Frame(bus, frame, time);
-    if (e.judge->decided()) Finish(e);
+  // Only the windows open before this frame judge it: a window that opens because of it (timed
+  // after the expectation it decides) starts with the next one.
+  std::vector<Expectation*>& open = frame_targets_;
+  open.clear();
+  for (auto& ptr : expects_)
+    if (ptr->opened && !ptr->reported) open.push_back(ptr.get());
+  for (Expectation* e : open) {
+    if (e->reported) continue;
+    e->judge->Frame(bus, frame, time);
+    if (e->judge->decided()) Finish(*e);
   }
 }
 

@@ -110,6 +110,7 @@ class ScenarioRunner {
   bool done_reported_ = false;
   std::vector<std::unique_ptr<Expectation>> expects_;
   std::vector<std::unique_ptr<Action>> actions_;
+  std::vector<Expectation*> frame_targets_;  ///< Frame()'s list, kept to reuse its storage
   /// Read callbacks that outlive the runner find it expired.
   std::shared_ptr<int> alive_ = std::make_shared<int>(0);
 };

@@ -139,6 +139,24 @@ scenario { name: "then" expect { after: "never" within_ms: 100 no_emcy {} } }
   EXPECT_EQ(done_, 1);
 }
 
+// An error reset right behind the EMCY it resets, in the same delivery: the window timed after the
+// EMCY is open for the reset, but not judged on the EMCY that opened it.
+TEST_F(ScenarioRunnerTest, AWindowOpenedByAFrameJudgesTheFramesAfterItNotThatOne) {
+  Run(R"(
+scenario { name: "emcy" expect { within_ms: 2000 emcy { node: "quad-6" code: 0x8140 } } }
+scenario { name: "quiet" expect { after: "emcy" within_ms: 100 no_emcy { code: 0x8140 } } }
+scenario { name: "reset" expect { after: "emcy" within_ms: 100 emcy { node: "quad-6" code: 0x0000 } } }
+)");
+  scheduler_.Advance(300ms);
+  runner_->Frame("can0", Emcy(6, 0x8140), T(300ms));
+  runner_->Frame("can0", Emcy(6, 0x0000), T(300ms));
+  ASSERT_NE(Decided("reset"), nullptr);
+  EXPECT_EQ(Decided("reset")->verdict.outcome, Outcome::kPassed);
+  EXPECT_EQ(Decided("quiet"), nullptr);
+  scheduler_.Advance(100ms);
+  EXPECT_EQ(Decided("quiet")->verdict.outcome, Outcome::kPassed);
+}
+
 TEST_F(ScenarioRunnerTest, ThroughoutPollsTheWholeWindow) {
   Run(R"(scenario { name: "hold" expect { within_ms: 1000 throughout: true controller { node: "quad-6" state: "error-active" } } })");
   scheduler_.Advance(500ms);
