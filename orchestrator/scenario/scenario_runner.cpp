@@ -158,9 +158,11 @@ void ScenarioRunner::Anchored(int step, TimePoint anchor) {
       e.opened = open;
       OpenWindow(e);
     });
-    // A window already due opens now, not on a timer: the frames that follow the anchor's in the
-    // same delivery (an error reset right after the EMCY it resets) must find it open.
-    if (open <= scheduler_.Now()) {
+    // A window already due, or one that opens at its anchor, opens now, not on a timer: the
+    // frames that follow the anchor's in the same delivery (an error reset right after the EMCY it
+    // resets) must find it open, and a paced bus delivers a round's frames with their end-of-frame
+    // times, which may lie a little ahead of the scheduler's now.
+    if (open <= scheduler_.Now() || e.spec->at_ms() == 0) {
       e.opened = open;
       OpenWindow(e);
     } else {
@@ -206,7 +208,8 @@ void ScenarioRunner::OpenWindow(Expectation& e) {
 void ScenarioRunner::PollOnce(Expectation& e) {
   if (e.reading || e.decided() || e.closing) return;
   Sample sample;
-  sample.time = scheduler_.Now();
+  // A window opened at an anchor slightly ahead of now (a frame's bus time) reads from its opening.
+  sample.time = std::max(scheduler_.Now(), e.judge->open_time());
   switch (e.judge->Needs()) {
     case Poll::kNmt:
       sample.text = probe_.NmtState(*e.port);

@@ -157,6 +157,23 @@ scenario { name: "reset" expect { after: "emcy" within_ms: 100 emcy { node: "qua
   EXPECT_EQ(Decided("quiet")->verdict.outcome, Outcome::kPassed);
 }
 
+// A paced bus delivers a round's frames with their end-of-frame times, which can lie ahead of the
+// scheduler's now: a window timed from such a frame opens at once and judges the next frames.
+TEST_F(ScenarioRunnerTest, AWindowAnchoredOnAFrameAheadOfNowOpensAtOnce) {
+  Run(R"(
+scenario { name: "emcy" expect { within_ms: 2000 emcy { node: "quad-6" code: 0x8140 } } }
+scenario { name: "reset" expect { after: "emcy" within_ms: 100 emcy { node: "quad-6" code: 0x0000 } } }
+scenario { name: "state" expect { after: "emcy" nmt { node: "quad-6" state: "operational" } } }
+)");
+  scheduler_.Advance(300ms);
+  runner_->Frame("can0", Emcy(6, 0x8140), T(300ms + 400us));
+  runner_->Frame("can0", Emcy(6, 0x0000), T(300ms + 900us));
+  ASSERT_NE(Decided("reset"), nullptr);
+  EXPECT_EQ(Decided("reset")->verdict.outcome, Outcome::kPassed);
+  ASSERT_NE(Decided("state"), nullptr);  // judged on a read taken as at its opening
+  EXPECT_EQ(Decided("state")->verdict.outcome, Outcome::kPassed);
+}
+
 TEST_F(ScenarioRunnerTest, ThroughoutPollsTheWholeWindow) {
   Run(R"(scenario { name: "hold" expect { within_ms: 1000 throughout: true controller { node: "quad-6" state: "error-active" } } })");
   scheduler_.Advance(500ms);
