@@ -26,6 +26,8 @@ fi
 cmake -S . -B build "${common[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build -j "$jobs" --output-on-failure
+# The scenario library's JUnit report (ctest's canfleet_scenario_library), for CI to keep.
+echo "scenario library JUnit report: build/scenarios-junit.xml"
 
 # The container fleet on the real Docker engine (docker/compose.yaml): builds canfleet:dev, checks
 # heartbeat loss on stop/kill/disconnect; prints "SKIPPED: <reason>" when no Docker engine answers.

@@ -116,6 +116,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
   });
   for (const auto& node : nodes_)
     if (!node.external()) supervisor_.Add(node.name(), NodeLaunch(node, options_), PolicyOf(node.spec));
+  WatchScenario();
 
   std::vector<ExternalAdoption::Port> external_ports;
   for (const auto& node : nodes_)
@@ -151,7 +152,11 @@ void Fleet::Start() {
 }
 
 void Fleet::Stop(std::function<void()> done) {
-  scenario_timers_.clear();
+  // The scenario ends here: what was decided stays readable, nothing more runs or is judged.
+  final_results_ = runner_->Results();
+  final_origin_ = runner_->origin();
+  scenario_taps_.clear();
+  runner_.reset();
   supervisor_.StopAll(std::move(done));
 }
 
@@ -263,52 +268,6 @@ void Fleet::CheckReady() {
   spdlog::info("fleet ready: every node booted and configured ({:.2f} s)", Uptime());
   StartScenario();
   if (on_ready_) on_ready_();
-}
-
-void Fleet::StartScenario() {
-  for (const auto& step : options_.topology.scenario()) {
-    auto timer = std::make_unique<Timer>(scheduler_, [this, step] { RunStep(step); });
-    timer->StartAfter(std::chrono::milliseconds(step.at_ms()));
-    scenario_timers_.push_back(std::move(timer));
-  }
-  if (!options_.topology.scenario().empty())
-    spdlog::info("scenario: {} step(s) scheduled", options_.topology.scenario_size());
-}
-
-void Fleet::RunStep(const topology::Step& step) {
-  const double t = step.at_ms() / 1000.0;
-  try {
-    switch (step.action_case()) {
-      case topology::Step::kInject:
-        faults_->Inject(step.inject());
-        break;
-      case topology::Step::kClear:
-        faults_->Clear(step.clear());
-        break;
-      case topology::Step::kIo: {
-        wire::NodeRequest request;
-        request.mutable_io_set()->set_name(step.io().name());
-        request.mutable_io_set()->set_value(step.io().value());
-        IoRequest(step.io().node(), request, [t, step](const std::string& error, const control::IoValues&) {
-          if (!error.empty())
-            spdlog::error("scenario t={}s: io {} {}: {}", t, step.io().node(), step.io().name(), error);
-        });
-        break;
-      }
-      case topology::Step::kNmt:
-        spdlog::info("scenario t={}s: {}", t, Nmt(step.nmt()));
-        break;
-      case topology::Step::kSdo:
-        SdoWrite(step.sdo(), [t](const std::string& error) {
-          if (!error.empty()) spdlog::error("scenario t={}s: sdo write: {}", t, error);
-        });
-        break;
-      default:
-        break;
-    }
-  } catch (const std::exception& e) {
-    spdlog::error("scenario t={}s: {}", t, e.what());
-  }
 }
 
 // ---- NMT ----

@@ -25,8 +25,10 @@
 #include "orchestrator/fleet/frame_feed.hpp"
 #include "orchestrator/fleet/master_port.hpp"
 #include "orchestrator/fleet/node_tracker.hpp"
+#include "orchestrator/fleet/scenario_tap.hpp"
 #include "orchestrator/fleet/sdo_queue.hpp"
 #include "orchestrator/fleet/supervisor.hpp"
+#include "orchestrator/scenario/scenario_runner.hpp"
 #include "orchestrator/topology/canfleet_topology.pb.h"
 #include "orchestrator/transport/broker_server.hpp"
 
@@ -45,7 +47,7 @@ struct FleetOptions {
   std::optional<WallTime> wall_origin;
 };
 
-class Fleet final : public control::ControlHandler {
+class Fleet final : public control::ControlHandler, public scenario::FleetProbe {
  public:
   Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker, transport::BrokerServer& server,
         FleetOptions options);
@@ -66,6 +68,28 @@ class Fleet final : public control::ControlHandler {
   }
 
   control::Status Status() const;
+
+  /// An expectation of the scenario was decided (issue 21).
+  void OnExpectation(std::function<void(const scenario::Result&)> handler) {
+    on_expectation_ = std::move(handler);
+  }
+  /// Every scenario step ran and every expectation was decided.
+  void OnScenarioDone(std::function<void()> handler) { on_scenario_done_ = std::move(handler); }
+  /// Every expectation of the scenario, decided or not, in file order.
+  std::vector<scenario::Result> ScenarioResults() const {
+    return runner_ ? runner_->Results() : final_results_;
+  }
+  /// When the scenario started (the fleet was ready); unset before.
+  std::optional<TimePoint> ScenarioOrigin() const { return runner_ ? runner_->origin() : final_origin_; }
+  bool Ready() const { return ready_; }
+
+  // scenario::FleetProbe: what the scenario's expectations read (fleet_scenario.cpp).
+  void ReadSdo(const scenario::PortAddress& port, std::size_t port_index, std::uint16_t index,
+               std::uint8_t subindex, SdoDone done) override;
+  void ReadIo(const std::string& node, const std::string& name, IoDone done) override;
+  std::string NmtState(const scenario::PortAddress& port) const override;
+  std::string ControllerState(const scenario::PortAddress& port) const override;
+  double LoadPercent(const std::string& bus) const override;
 
   // control::ControlHandler
   void Handle(const control::Request& request, std::shared_ptr<control::Responder> responder) override;
@@ -115,12 +139,18 @@ class Fleet final : public control::ControlHandler {
   std::unique_ptr<FaultManager> faults_;
   std::unique_ptr<ExternalAdoption> adoption_;  ///< running external nodes that attach without a boot-up
   Captures captures_;
-  std::vector<std::unique_ptr<Timer>> scenario_timers_;
+  void WatchScenario();
+  std::unique_ptr<scenario::ScenarioRunner> runner_;
+  std::vector<scenario::Result> final_results_;  ///< after Stop
+  std::optional<TimePoint> final_origin_;
+  std::vector<std::unique_ptr<ScenarioTap>> scenario_taps_;  ///< listen-only, one per bus, for expectations
   bool ready_ = false;
 
   std::function<void()> on_ready_;
   std::function<void()> on_shutdown_request_;
   std::function<void(const control::FaultStatus&, bool)> on_fault_event_;
+  std::function<void(const scenario::Result&)> on_expectation_;
+  std::function<void()> on_scenario_done_;
 };
 
 }  // namespace canfleet::fleet

@@ -21,7 +21,20 @@ namespace canfleet::fleet {
 
 namespace {
 
-/// canfleet-node: asked for, else beside this executable, else on PATH.
+/// Written then renamed, so a reader never sees half a file.
+void WriteStateFile(const std::filesystem::path& path, const std::string& control, const std::string& broker,
+                    const char* state) {
+  if (path.empty()) return;
+  const auto tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << "control " << control << "\nbroker " << broker << "\nstate " << state << "\n";
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
 std::filesystem::path FindNodeBinary(const std::filesystem::path& asked) {
   if (!asked.empty()) {
     if (::access(asked.c_str(), X_OK) != 0)
@@ -46,20 +59,6 @@ std::filesystem::path FindNodeBinary(const std::filesystem::path& asked) {
   }
   throw std::runtime_error("canfleet-node not found beside canfleet nor on PATH (use --node-binary)");
 }
-
-/// Written then renamed, so a reader never sees half a file.
-void WriteStateFile(const std::filesystem::path& path, const std::string& control, const std::string& broker,
-                    const char* state) {
-  if (path.empty()) return;
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << "control " << control << "\nbroker " << broker << "\nstate " << state << "\n";
-  }
-  std::filesystem::rename(tmp, path);
-}
-
-}  // namespace
 
 int RunFleet(const UpOptions& options) {
   topology::LoadedTopology loaded;

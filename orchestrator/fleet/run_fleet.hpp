@@ -25,6 +25,10 @@ struct UpOptions {
   telemetry::DdsOptions dds;
 };
 
+/// canfleet-node: `asked` when given (it must be executable), else beside this executable, else on
+/// PATH. Throws std::runtime_error naming what was tried.
+std::filesystem::path FindNodeBinary(const std::filesystem::path& asked);
+
 /// Runs the fleet in the calling thread. Returns the process exit code: 0 after a clean
 /// shutdown, 2 when the topology is refused (the message names file, line and field) or an
 /// endpoint cannot be bound.

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "orchestrator/control/fault_kinds.hpp"
+#include "orchestrator/topology/expect_checks.hpp"
 #include "orchestrator/topology/node_checks.hpp"
 
 namespace canfleet::topology::detail {
@@ -16,6 +17,23 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
   std::stable_sort(order.begin(), order.end(), [this](int a, int b) {
     return facts_.spec.scenario(a).at_ms() < facts_.spec.scenario(b).at_ms();
   });
+  // Names, and what expectations are timed after: a named step earlier in the file.
+  std::map<std::string, int> names;
+  for (int i = 0; i < facts_.spec.scenario_size(); ++i) {
+    const Step& step = facts_.spec.scenario(i);
+    const Scope s = root.Child("scenario", step, i);
+    if (step.has_expect() && !step.expect().after().empty() && !names.contains(step.expect().after()))
+      s.Child("expect", step.expect())
+          .Fail("after", "no step earlier in the file is named " + Quote(step.expect().after()));
+    if (step.name().empty()) continue;
+    if (const std::string problem = BusNameProblem(step.name()); !problem.empty())
+      s.Fail("name", "step name " + problem);
+    const auto [it, fresh] = names.emplace(step.name(), i);
+    if (!fresh)
+      s.Fail("name", Quote(step.name()) + " already names scenario[" + std::to_string(it->second) + "] (" +
+                         LineRef(root.Child("scenario", facts_.spec.scenario(it->second), it->second).loc()) +
+                         ")");
+  }
   std::map<std::string, int> labels;  // label -> step that injects it
   for (int i : order) {
     const Step& step = facts_.spec.scenario(i);
@@ -48,8 +66,11 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
         CheckSdo(ws, facts, w.index(), w.subindex(), w.type(), w.value(), w.port());
         break;
       }
+      case Step::kExpect:
+        CheckExpect(s.Child("expect", step.expect()), facts_, step.expect());
+        break;
       case Step::ACTION_NOT_SET:
-        s.FailHere("a step needs an action: inject, clear, io, nmt or sdo");
+        s.FailHere("a step needs an action: inject, clear, io, nmt, sdo or expect");
     }
   }
 }

@@ -56,7 +56,10 @@ class Loader {
     nodes.CheckHeartbeats(root);
     ScenarioChecks(facts_).CheckScenario(root);
     ApplyDefaults();
-    return LoadedTopology{std::move(spec_), file_};
+    std::vector<int> step_lines;
+    for (int i = 0; i < spec_.scenario_size(); ++i)
+      step_lines.push_back(root.Child("scenario", spec_.scenario(i), i).loc().line);
+    return LoadedTopology{std::move(spec_), file_, std::move(step_lines)};
   }
 
  private:

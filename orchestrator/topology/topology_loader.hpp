@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "orchestrator/topology/canfleet_topology.pb.h"
 
@@ -54,6 +55,7 @@ class TopologyError : public std::runtime_error {
 struct LoadedTopology {
   Topology spec;
   std::filesystem::path file;
+  std::vector<int> step_lines;  ///< the line of each scenario step (1-based), for reports
 };
 
 /// Reads, parses, validates and completes a topology file. Relative paths inside it are relative

@@ -47,7 +47,8 @@ struct Cli {
 
 // One function per command group, each in its own file; each adds its subcommands to `app` and
 // sets cli.action when chosen.
-void AddUpCommands(CLI::App& app, Cli& cli);  ///< up, down, check
+void AddUpCommands(CLI::App& app, Cli& cli);   ///< up, down, check
+void AddTestCommand(CLI::App& app, Cli& cli);  ///< test (scenario files with expectations)
 void AddStatusCommand(CLI::App& app, Cli& cli);
 void AddFaultCommands(CLI::App& app, Cli& cli);
 void AddIoCommands(CLI::App& app, Cli& cli);

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
 
   AddUpCommands(app, cli);
+  AddTestCommand(app, cli);
   AddStatusCommand(app, cli);
   AddFaultCommands(app, cli);
   AddIoCommands(app, cli);

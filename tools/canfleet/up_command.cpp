@@ -45,8 +45,15 @@ std::string Plural(int n, const char* one, const char* many) {
 int RunCheck(const std::string& file) {
   try {
     const topology::LoadedTopology loaded = topology::LoadTopology(file);
+    int expectations = 0;
+    for (const auto& step : loaded.spec.scenario())
+      expectations += step.has_expect() ? 1 : 0;
     std::cout << "ok: " << Plural(loaded.spec.bus_size(), "bus", "buses") << ", "
-              << Plural(loaded.spec.node_size(), "node", "nodes") << '\n';
+              << Plural(loaded.spec.node_size(), "node", "nodes");
+    if (loaded.spec.scenario_size() > 0)
+      std::cout << ", " << Plural(loaded.spec.scenario_size() - expectations, "action", "actions") << ", "
+                << Plural(expectations, "expectation", "expectations");
+    std::cout << '\n';
     return kExitOk;
   } catch (const topology::TopologyError& e) {
     std::cerr << e.what() << '\n';

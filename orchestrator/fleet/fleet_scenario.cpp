@@ -1,0 +1,131 @@
+// The fleet's scenario (issue 21): action steps run by the scenario runner on the fleet's
+// scheduler, expectations judged on what the orchestrator sees — every frame of each bus through
+// a listen-only tap (error frames included), and the reads of scenario::FleetProbe answered
+// here: SDO uploads by the master's client, simulated I/O over the node's broker connection, NMT
+// states from heartbeats, controller states and bus load from the broker.
+#include <spdlog/spdlog.h>
+
+#include "orchestrator/fleet/fleet.hpp"
+#include "orchestrator/fleet/scenario_tap.hpp"
+
+namespace canfleet::fleet {
+
+void Fleet::WatchScenario() {
+  runner_ = std::make_unique<scenario::ScenarioRunner>(
+      scheduler_, options_.topology, *this,
+      scenario::ScenarioRunner::Hooks{
+          .act = [this](const topology::Step& step) { RunStep(step); },
+          .decided =
+              [this](const scenario::Result& result) {
+                const auto& v = result.verdict;
+                const std::string line = std::string("expect ") + scenario::OutcomeName(v.outcome) + " " +
+                                         result.name + ": " + result.description +
+                                         (v.detail.empty() ? "" : ": " + v.detail);
+                if (v.outcome == scenario::Outcome::kPassed)
+                  spdlog::info("{}", line);
+                else
+                  spdlog::warn("{}", line);
+                if (on_expectation_) on_expectation_(result);
+              },
+          .done =
+              [this] {
+                if (runner_->Expectations() > 0)
+                  spdlog::info("scenario: every step ran, every expectation decided");
+                if (on_scenario_done_) on_scenario_done_();
+              },
+      });
+  if (runner_->Expectations() == 0) return;
+  for (const auto& bus : broker_.Buses())
+    scenario_taps_.push_back(std::make_unique<ScenarioTap>(broker_, bus, *runner_));
+}
+
+void Fleet::StartScenario() {
+  if (!options_.topology.scenario().empty())
+    spdlog::info("scenario: {} step(s), {} expectation(s)", options_.topology.scenario_size(),
+                 runner_->Expectations());
+  runner_->Start();
+}
+
+void Fleet::RunStep(const topology::Step& step) {
+  const double t = step.at_ms() / 1000.0;
+  try {
+    switch (step.action_case()) {
+      case topology::Step::kInject:
+        faults_->Inject(step.inject());
+        break;
+      case topology::Step::kClear:
+        faults_->Clear(step.clear());
+        break;
+      case topology::Step::kIo: {
+        wire::NodeRequest request;
+        request.mutable_io_set()->set_name(step.io().name());
+        request.mutable_io_set()->set_value(step.io().value());
+        IoRequest(step.io().node(), request, [t, step](const std::string& error, const control::IoValues&) {
+          if (!error.empty())
+            spdlog::error("scenario t={}s: io {} {}: {}", t, step.io().node(), step.io().name(), error);
+        });
+        break;
+      }
+      case topology::Step::kNmt:
+        spdlog::info("scenario t={}s: {}", t, Nmt(step.nmt()));
+        break;
+      case topology::Step::kSdo:
+        SdoWrite(step.sdo(), [t](const std::string& error) {
+          if (!error.empty()) spdlog::error("scenario t={}s: sdo write: {}", t, error);
+        });
+        break;
+      default:
+        break;
+    }
+  } catch (const std::exception& e) {
+    spdlog::error("scenario t={}s: {}", t, e.what());
+  }
+}
+
+void Fleet::ReadSdo(const scenario::PortAddress& port, std::size_t port_index, std::uint16_t index,
+                    std::uint8_t subindex, SdoDone done) {
+  (void)port_index;  // the address says which bus and node-ID
+  sdo_.at(port.bus)->Read(port.node_id, index, subindex, false,
+                          [done](canopen::SdoAbort abort, canopen::Bytes data) {
+                            if (abort != canopen::SdoAbort::kNone)
+                              return done(static_cast<std::uint32_t>(abort), {}, {});
+                            done(std::nullopt, std::vector<std::uint8_t>(data.begin(), data.end()), {});
+                          });
+}
+
+void Fleet::ReadIo(const std::string& node, const std::string& name, IoDone done) {
+  wire::NodeRequest request;
+  request.mutable_io_get()->set_name(name);
+  try {
+    IoRequest(node, request, [done, name](const std::string& error, const control::IoValues& values) {
+      if (!error.empty()) return done(error, {}, {});
+      for (const auto& v : values.values())
+        if (v.name() == name) return done({}, v.value(), v.unit());
+      done("no signal " + name + " in the node's answer", {}, {});
+    });
+  } catch (const std::exception& e) {
+    done(e.what(), {}, {});
+  }
+}
+
+std::string Fleet::NmtState(const scenario::PortAddress& port) const {
+  const NodeLiveState* live = tracker_.Find(port.bus, port.node_id);
+  return NmtStateName(live ? live->nmt_state : std::nullopt);
+}
+
+std::string Fleet::ControllerState(const scenario::PortAddress& port) const {
+  std::string state;
+  for (const auto& p : broker_.Ports(port.bus)) {
+    if (p.name != port.node) continue;  // the newest attachment of a name wins
+    state = p.controller.state == ControllerState::kBusOff         ? "bus-off"
+            : p.controller.state == ControllerState::kErrorPassive ? "error-passive"
+                                                                   : "error-active";
+  }
+  return state;
+}
+
+double Fleet::LoadPercent(const std::string& bus) const {
+  return broker_.Stats(bus, 0).load_percent;
+}
+
+}  // namespace canfleet::fleet

@@ -1,0 +1,118 @@
+#pragma once
+/// @file Runs a topology's scenario on the orchestrator's scheduler (issue 21): action steps at
+/// their times, expectations in their windows. Every timer is a canfleet::Timer on the Scheduler
+/// it is given, so the same runner works in real time (`canfleet up`, `canfleet test`), in unit
+/// tests on simulated time, and later in virtual time.
+///
+/// What the runner needs of a fleet is FleetProbe: reads it polls while a window is open (SDO, a
+/// simulated signal, NMT state, controller state, bus load). Frames (every frame and error frame a
+/// listen-only monitor sees on each bus) are pushed into it with Frame().
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "clock/scheduler.hpp"
+#include "orchestrator/scenario/judge.hpp"
+#include "orchestrator/topology/canfleet_topology.pb.h"
+
+namespace canfleet::scenario {
+
+/// The reads of a running fleet the runner polls. Answers may come later (on the same thread).
+class FleetProbe {
+ public:
+  using SdoDone = std::function<void(std::optional<std::uint32_t> abort, std::vector<std::uint8_t> data,
+                                     std::string error)>;
+  using IoDone = std::function<void(std::string error, std::string value, std::string unit)>;
+
+  virtual ~FleetProbe() = default;
+  virtual void ReadSdo(const PortAddress& port, std::size_t port_index, std::uint16_t index,
+                       std::uint8_t subindex, SdoDone done) = 0;
+  virtual void ReadIo(const std::string& node, const std::string& name, IoDone done) = 0;
+  /// From its heartbeats: "operational", "pre-operational", "stopped", "initialising", "unknown".
+  virtual std::string NmtState(const PortAddress& port) const = 0;
+  /// "error-active", "error-passive", "bus-off"; "" when the port is not attached.
+  virtual std::string ControllerState(const PortAddress& port) const = 0;
+  virtual double LoadPercent(const std::string& bus) const = 0;
+};
+
+/// One expectation's result.
+struct Result {
+  int step = 0;             ///< index in Topology.scenario
+  std::string name;         ///< the step's name, or "scenario[i]"
+  std::string description;  ///< "EMCY 8130h from quad-6 within 1500 ms after cut-hb"
+  Verdict verdict;
+  std::optional<TimePoint> opened;  ///< when its window opened (unset: never)
+};
+
+struct RunnerOptions {
+  /// How often reads are repeated while a window is open: reads over the bus or a node
+  /// connection (SDO, simulated I/O) and reads of the orchestrator's own state (NMT state,
+  /// controllers, bus load; a held bus-off is seen, a 5 ms automatic recovery may not be).
+  Duration remote_poll = std::chrono::milliseconds(100);
+  Duration local_poll = std::chrono::milliseconds(10);
+  /// A read still unanswered this long after its window closed is given up (the judge decides
+  /// on what it has).
+  Duration read_grace = std::chrono::seconds(5);
+};
+
+class ScenarioRunner {
+ public:
+  struct Hooks {
+    std::function<void(const topology::Step&)> act;  ///< runs an action step (inject, io, ...)
+    std::function<void(const Result&)> decided;      ///< an expectation was decided
+    std::function<void()> done;                      ///< every step ran and every expectation is decided
+  };
+
+  /// `topology` must have loaded (topology_loader: every name resolves, defaults applied).
+  /// Throws std::invalid_argument when an expectation cannot be judged (the loader refuses those).
+  ScenarioRunner(Scheduler& scheduler, const topology::Topology& topology, FleetProbe& probe, Hooks hooks,
+                 RunnerOptions options = {});
+  ~ScenarioRunner();
+  ScenarioRunner(const ScenarioRunner&) = delete;
+  ScenarioRunner& operator=(const ScenarioRunner&) = delete;
+
+  /// The scenario starts now (the fleet is ready).
+  void Start();
+  /// A frame seen on `bus` at `time` (bus time = scheduler time).
+  void Frame(const std::string& bus, const CanFrame& frame, TimePoint time);
+
+  /// Every expectation in file order; decided ones have their verdict.
+  std::vector<Result> Results() const;
+  std::size_t Expectations() const { return expects_.size(); }
+  bool Done() const;
+  /// When the scenario started (unset before Start).
+  std::optional<TimePoint> origin() const {
+    return started_ ? std::optional<TimePoint>(origin_) : std::nullopt;
+  }
+
+ private:
+  struct Expectation;
+  struct Action;
+  void Anchored(int step, TimePoint anchor);
+  void AnchorLost(int step, const std::string& why);
+  void OpenWindow(Expectation& e);
+  void PollOnce(Expectation& e);
+  void ReadDone(Expectation& e, const Sample& sample);
+  void CloseWindow(Expectation& e);
+  void Finish(Expectation& e);
+  void CheckDone();
+
+  Scheduler& scheduler_;
+  const topology::Topology& topology_;
+  FleetProbe& probe_;
+  Hooks hooks_;
+  RunnerOptions options_;
+  TimePoint origin_{};
+  bool started_ = false;
+  bool done_reported_ = false;
+  std::vector<std::unique_ptr<Expectation>> expects_;
+  std::vector<std::unique_ptr<Action>> actions_;
+  std::vector<Expectation*> frame_targets_;  ///< Frame()'s list, kept to reuse its storage
+  /// Read callbacks that outlive the runner find it expired.
+  std::shared_ptr<int> alive_ = std::make_shared<int>(0);
+};
+
+}  // namespace canfleet::scenario
