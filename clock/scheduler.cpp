@@ -190,6 +190,9 @@ void Timer::StartAfter(Duration delay) {
   StartAt(scheduler_.Now() + delay);
 }
 void Timer::Cancel() {
+  // A timer that is not armed never touches its scheduler, so one may be destroyed (or cancelled)
+  // after the scheduler it was made with, as long as it is not armed then.
+  if (heap_index_ == kNotArmed) return;
   scheduler_.Disarm(*this);
 }
 void Timer::Sleep(Duration period) {

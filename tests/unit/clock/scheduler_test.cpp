@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 #include <string>
 
@@ -123,6 +124,26 @@ TEST(SimulatedScheduler, RandomisedOperationsKeepDeadlineOrder) {
   s.RunUntilIdle(1h);
   EXPECT_TRUE(std::is_sorted(fired_at.begin(), fired_at.end()));
   EXPECT_EQ(s.ArmedCount(), 0u);
+}
+
+}  // namespace
+}  // namespace canfleet
+
+namespace canfleet {
+namespace {
+
+// An object holding a timer may be destroyed after the scheduler it was made with (the socketcand
+// session's shutdown did): an unarmed timer's Cancel, and so its destructor, must not touch the
+// scheduler (ASan in the sanitizer job sees a use after free if it does).
+TEST(SimulatedScheduler, AnUnarmedTimerMayOutliveItsScheduler) {
+  auto scheduler = std::make_unique<SimulatedScheduler>();
+  auto timer = std::make_unique<Timer>(*scheduler, [] {});
+  timer->StartAfter(std::chrono::milliseconds(5));
+  scheduler->Advance(std::chrono::milliseconds(5));  // fired: no longer armed
+  scheduler.reset();
+  timer->Cancel();
+  timer.reset();
+  SUCCEED();
 }
 
 }  // namespace
