@@ -158,7 +158,7 @@ int WriteEds(const std::string& device, const std::string& path) {
     throw std::invalid_argument("--write-eds needs --device NAME (known: " + devices::KnownDeviceNames() +
                                 ")");
   }
-  const std::string_view text = variant->eds_text();
+  const std::string text = variant->eds().Text();
   if (path == "-") {
     std::cout << text;
     return 0;

@@ -40,7 +40,7 @@ DataLogger::~DataLogger() = default;
 
 void DataLogger::Build(std::size_t port, canopen::ObjectDictionary& od) {
   if (port == 0 || shared_od_ == nullptr) {
-    od = LoadVariantDictionary(DataLoggerEdsText(), "datalogger-tc-analog.eds", options_.eds);
+    od = LoadVariantDictionary(DataLoggerEds(), "datalogger-tc-analog.eds", options_.eds);
     if (port == 0) shared_od_ = &od;
     return;
   }

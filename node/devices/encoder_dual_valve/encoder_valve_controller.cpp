@@ -42,7 +42,7 @@ EncoderValveController::~EncoderValveController() {
 
 void EncoderValveController::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(EncoderEdsText(), "encoder-dual-valve.eds", options_.eds);
+  od = LoadVariantDictionary(EncoderEds(), "encoder-dual-valve.eds", options_.eds);
   od_ = &od;
 }
 

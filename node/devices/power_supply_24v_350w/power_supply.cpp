@@ -49,7 +49,7 @@ void PowerSupply::DeclareSignals(SimulatedIo& io) {
 
 void PowerSupply::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(PowerSupplyEdsText(), kEdsFileName, options_.eds);
+  od = LoadVariantDictionary(PowerSupplyEds(), kEdsFileName, options_.eds);
   od_ = &od;
 }
 

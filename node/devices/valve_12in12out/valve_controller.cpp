@@ -36,7 +36,7 @@ ValveController::~ValveController() {
 
 void ValveController::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(ValveEdsText(), kEdsFileName, options_.eds);
+  od = LoadVariantDictionary(ValveEds(), kEdsFileName, options_.eds);
   od_ = &od;
 }
 
