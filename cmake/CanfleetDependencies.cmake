@@ -8,6 +8,10 @@ find_package(Threads REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
 find_package(CLI11 REQUIRED)
+# zlib inflates the EDS every variant compiles in (node/devices/embedded_eds.hpp). Static: a node
+# then carries inflate() alone rather than mapping all of libz.so (idle RSS, bench/idle/README.md).
+set(ZLIB_USE_STATIC_LIBS ON)
+find_package(ZLIB REQUIRED)
 
 # Asio standalone has no CMake package in Debian: an INTERFACE target over its header.
 find_path(ASIO_INCLUDE_DIR asio.hpp REQUIRED)

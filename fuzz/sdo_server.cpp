@@ -39,7 +39,7 @@ void AddObjects(ObjectDictionary& od) {
   limited.high_limit = EncodeLe<std::uint32_t>(1000);
   od.AddVar(0x2002, "Write only", DataType::kUnsigned32, Access::kWo, EncodeLe<std::uint32_t>(0));
   auto& vetoed = od.AddVar(0x2003, "Vetoed", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0));
-  vetoed.validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+  vetoed.AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
     return !data.empty() && data[0] == 0x22 ? SdoAbort::kDeviceState : SdoAbort::kNone;
   });
   od.AddVar(0x2004, "Domain", DataType::kDomain, Access::kRw, Bytes(300, 0x5A));

@@ -14,7 +14,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config git
-  libasio-dev libspdlog-dev libfmt-dev libcli11-dev
+  libasio-dev libspdlog-dev libfmt-dev libcli11-dev zlib1g-dev
   libprotobuf-dev protobuf-compiler
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -125,9 +125,9 @@ void DeviceNode::ForwardSharedStorage() {
       const std::uint32_t signature = store ? canopen::kSaveSignature : canopen::kLoadSignature;
       for (auto& [sub_index, sub] : object->subs) {
         if (sub_index == 0 || sub_index == 2) continue;
-        sub.validators.push_back([primary, store, signature, range = *range](
-                                     const canopen::SubObject& s, std::span<const std::uint8_t> data,
-                                     canopen::Origin) {
+        sub.AddValidator([primary, store, signature, range = *range](const canopen::SubObject& s,
+                                                                     std::span<const std::uint8_t> data,
+                                                                     canopen::Origin) {
           if (data.size() != 4 || canopen::DecodeUnsignedLe(data) != signature)
             return canopen::SdoAbort::kNone;
           for (const auto& group : canopen::ParameterGroups()) {

@@ -37,7 +37,7 @@ std::span<const DeviceInfo> Devices() {
        .factory_node_id = 127,
        .factory_bit_rate_kbit = 125,
        .eds_file_name = "quad-controller.eds",
-       .eds_text = QuadControllerEdsText,
+       .eds = QuadControllerEds,
        .declare_signals = [](SimulatedIo& io) { quad::QuadIo declared(io); },
        .create = Create<QuadController>},
       {.name = ValveController::kName,
@@ -46,7 +46,7 @@ std::span<const DeviceInfo> Devices() {
        .factory_node_id = 127,  // UMAX020411A §3.1: node-ID 127, 125 kbit/s
        .factory_bit_rate_kbit = 125,
        .eds_file_name = "valve-12in12out.eds",
-       .eds_text = ValveEdsText,
+       .eds = ValveEds,
        .declare_signals = [](SimulatedIo& io) { valve::DeclareValveSignals(io); },
        .create = Create<ValveController>},
       {.name = EncoderValveController::kName,
@@ -55,7 +55,7 @@ std::span<const DeviceInfo> Devices() {
        .factory_node_id = 127,  // AX023241 chapter 3 §1.1: node-ID 127, 125 kbit/s
        .factory_bit_rate_kbit = 125,
        .eds_file_name = "encoder-dual-valve.eds",
-       .eds_text = EncoderEdsText,
+       .eds = EncoderEds,
        .declare_signals = [](SimulatedIo& io) { encoder::DeclareEncoderSignals(io); },
        .create = Create<EncoderValveController>},
       {.name = DataLogger::kName,
@@ -65,7 +65,7 @@ std::span<const DeviceInfo> Devices() {
        .factory_node_id = 127,
        .factory_bit_rate_kbit = 125,
        .eds_file_name = "datalogger-tc-analog.eds",
-       .eds_text = DataLoggerEdsText,
+       .eds = DataLoggerEds,
        .declare_signals = datalogger::DeclareDataLoggerSignals,
        .create = Create<DataLogger>},
       {.name = PowerSupply::kName,
@@ -74,7 +74,7 @@ std::span<const DeviceInfo> Devices() {
        .factory_node_id = PowerSupply::kFactoryNodeId,  // UMAX080311 §2.1
        .factory_bit_rate_kbit = PowerSupply::kFactoryBitRateKbit,
        .eds_file_name = PowerSupply::kEdsFileName,
-       .eds_text = PowerSupplyEdsText,
+       .eds = PowerSupplyEds,
        .declare_signals = PowerSupply::DeclareSignals,
        .create = Create<PowerSupply>},
   }};
@@ -119,7 +119,7 @@ std::unique_ptr<SimulatedIo> SignalsOf(const DeviceInfo& info) {
 }
 
 canopen::ObjectDictionary VariantDictionary(const DeviceInfo& info, const std::filesystem::path& eds) {
-  return LoadVariantDictionary(info.eds_text(), info.eds_file_name, eds);
+  return LoadVariantDictionary(info.eds(), info.eds_file_name, eds);
 }
 
 std::optional<std::uint8_t> BitTimingIndexOf(std::uint32_t kbit) {

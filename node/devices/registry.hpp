@@ -17,6 +17,7 @@
 
 #include "node/canopen/od/object_dictionary.hpp"
 #include "node/devices/device.hpp"
+#include "node/devices/embedded_eds.hpp"
 
 namespace canfleet::devices {
 
@@ -29,7 +30,7 @@ struct DeviceInfo {
   std::uint8_t factory_node_id = 127;
   std::uint32_t factory_bit_rate_kbit = 125;
   std::string_view eds_file_name;         ///< "quad-controller.eds", for messages and --write-eds
-  std::string_view (*eds_text)();         ///< the EDS generated from the variant's dictionary table
+  EmbeddedEds (*eds)();                   ///< the EDS generated from the variant's dictionary table
   void (*declare_signals)(SimulatedIo&);  ///< declares the simulated I/O into an empty SimulatedIo
   std::unique_ptr<Device> (*create)(const DeviceOptions&);
 };

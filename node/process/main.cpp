@@ -18,6 +18,7 @@
 #include "node/devices/registry.hpp"
 #include "node/process/node_options.hpp"
 #include "node/process/node_telemetry_wiring.hpp"
+#include "node/process/release_memory.hpp"
 #include "node/process/remote_io.hpp"
 #include "node/process/stdin_control.hpp"
 
@@ -100,6 +101,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     if (++connected_ports == port_count) {
       node->Start();
       log->info("powered on");
+      node::ReleaseFreedHeap();  // what loading the stored parameters freed
     }
   };
   std::vector<std::unique_ptr<BusPort>> ports;
@@ -138,6 +140,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     if (!ec) log->info("signal {}: shutting down", signal);
     io.stop();
   });
+  node::ReleaseFreedHeap();  // what parsing the EDS and building the dictionaries freed
   log->info("{} node-ID {} on {} port(s); waiting for the bus", node->device().Name(),
             static_cast<int>(options.node_ids[0]), port_count);
   io.run();
@@ -155,7 +158,7 @@ int WriteEds(const std::string& device, const std::string& path) {
     throw std::invalid_argument("--write-eds needs --device NAME (known: " + devices::KnownDeviceNames() +
                                 ")");
   }
-  const std::string_view text = variant->eds_text();
+  const std::string text = variant->eds().Text();
   if (path == "-") {
     std::cout << text;
     return 0;

@@ -29,10 +29,7 @@ std::string Hex(const Bytes& bytes) {
   return out.empty() ? "(empty)" : out;
 }
 
-std::string Show(const std::optional<Bytes>& bytes) {
-  return bytes ? Hex(*bytes) : "(none)";
-}
-std::string Show(const Bytes& bytes) {
+std::string Show(const SmallBytes& bytes) {
   return Hex(bytes);
 }
 std::string Show(const std::string& text) {

@@ -56,16 +56,16 @@ Emcy::Emcy(ObjectDictionary& od, BusPort& port, Scheduler& scheduler, EmcyOption
 void Emcy::InstallHooks() {
   if (register_sub_) {
     // Read-only for SDO; anything else that writes it (a restore of defaults) is undone.
-    register_sub_->listeners.push_back([this](SubObject&, Origin) {
+    register_sub_->AddListener([this](SubObject&, Origin) {
       if (!syncing_) SyncRegister();
     });
   }
   if (count_sub_) {
     // CiA 301 §7.5.2.4: writing 0 to sub-index 0 deletes the history; other values are refused.
-    count_sub_->validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+    count_sub_->AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
       return DecodeUnsignedLe(data) == 0 ? SdoAbort::kNone : SdoAbort::kInvalidValue;
     });
-    count_sub_->listeners.push_back([this](SubObject& sub, Origin origin) {
+    count_sub_->AddListener([this](SubObject& sub, Origin origin) {
       if (syncing_) return;
       // The device side (RestoreDefaults at reset communication, device code) does not edit the
       // history by writing the count: it is put back. ClearHistory() is the device's way.
@@ -79,27 +79,27 @@ void Emcy::InstallHooks() {
   for (std::size_t i = 0; i < entry_subs_.size(); ++i) {
     SubObject& entry = *entry_subs_[i];
     // Entries are read-only even if a device file declares them rw.
-    entry.validators.push_back(
+    entry.AddValidator(
         [](const SubObject&, std::span<const std::uint8_t>, Origin) { return SdoAbort::kReadOnly; });
-    entry.listeners.push_back([this](SubObject&, Origin) {
+    entry.AddListener([this](SubObject&, Origin) {
       if (!syncing_) SyncHistory();
     });
     // Reading past the number of errors answers "no data available" (CANopenNode OD_read_1003).
-    entry.read_hooks.push_back(
+    entry.AddReadHook(
         [this, i](SubObject&, Origin) { return i < history_.size() ? SdoAbort::kNone : SdoAbort::kNoData; });
   }
   if (cob_id_sub_) {
-    cob_id_sub_->validators.push_back([this](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+    cob_id_sub_->AddValidator([this](const SubObject&, std::span<const std::uint8_t> data, Origin) {
       return ValidateEmcyCobIdWrite(CobIdValue(), static_cast<std::uint32_t>(DecodeUnsignedLe(data)));
     });
-    cob_id_sub_->listeners.push_back([this](SubObject& sub, Origin) {
+    cob_id_sub_->AddListener([this](SubObject& sub, Origin) {
       if (syncing_) return;
       LoadCobId(static_cast<std::uint32_t>(DecodeUnsignedLe(sub.value)));
       SyncCobId();
     });
   }
   if (SubObject* inhibit = od_.Find(kInhibitTimeIndex, 0)) {
-    inhibit->listeners.push_back([this](SubObject&, Origin) { LoadInhibitTime(); });
+    inhibit->AddListener([this](SubObject&, Origin) { LoadInhibitTime(); });
   }
 }
 

@@ -18,7 +18,7 @@ NodeGuarding::NodeGuarding(ObjectDictionary& od, BusPort& port, Scheduler& sched
       }) {
   for (std::uint16_t index : {kGuardTimeIndex, kLifeTimeFactorIndex, kProducerHeartbeatTime}) {
     if (SubObject* sub = od_.Find(index, 0)) {
-      sub->listeners.push_back([this](SubObject&, Origin) { OnConfigChanged(); });
+      sub->AddListener([this](SubObject&, Origin) { OnConfigChanged(); });
     }
   }
 }

@@ -41,15 +41,15 @@ HeartbeatConsumer::HeartbeatConsumer(ObjectDictionary& od, Scheduler& scheduler,
   for (auto& [sub_index, sub] : obj->subs) {
     if (sub_index == 0) {
       // CiA 301 §7.5.2.19: sub0 is the number of entries, read-only even if an EDS says rw.
-      sub.validators.push_back(
+      sub.AddValidator(
           [](const SubObject&, std::span<const std::uint8_t>, Origin) { return SdoAbort::kReadOnly; });
       continue;
     }
     entries_.push_back(std::make_unique<Entry>(scheduler, *this, sub_index));
-    sub.validators.push_back([this](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+    sub.AddValidator([this](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
       return Validate(s.sub_index, data);
     });
-    sub.listeners.push_back([this](SubObject& s, Origin) { Apply(s.sub_index, false); });
+    sub.AddListener([this](SubObject& s, Origin) { Apply(s.sub_index, false); });
   }
   Apply(0, true);
 }

@@ -12,7 +12,7 @@ HeartbeatProducer::HeartbeatProducer(ObjectDictionary& od, BusPort& port, Schedu
     : od_(od), port_(port), state_(std::move(state)), timer_(scheduler, [this] { OnTimer(); }) {
   if (SubObject* sub = od_.Find(kProducerHeartbeatTimeIndex, 0)) {
     // CiA 301 §7.2.8.3.2.2: a new producer time applies at once; restart the period from now.
-    sub->listeners.push_back([this](SubObject&, Origin) {
+    sub->AddListener([this](SubObject&, Origin) {
       if (running_) Arm();
     });
   }

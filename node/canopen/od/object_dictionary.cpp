@@ -3,10 +3,57 @@
 namespace canfleet::canopen {
 
 Bytes SubObject::DefaultFor(std::uint8_t node_id) const {
-  if (!default_adds_node_id || IsVariableLength(type)) return default_value;
+  if (!default_adds_node_id || IsVariableLength(type)) return Bytes(default_value);
   auto size = default_value.size();
   if (IsSigned(type)) return EncodeLe(DecodeSignedLe(default_value) + node_id, size);
   return EncodeLe(DecodeUnsignedLe(default_value) + node_id, size);
+}
+
+SubObject::SubObject(const SubObject& other)
+    : index(other.index),
+      sub_index(other.sub_index),
+      access(other.access),
+      type(other.type),
+      pdo_mappable(other.pdo_mappable),
+      default_adds_node_id(other.default_adds_node_id),
+      obj_flags(other.obj_flags),
+      name(other.name),
+      low_limit(other.low_limit),
+      high_limit(other.high_limit),
+      default_value(other.default_value),
+      value(other.value),
+      hooks_(other.hooks_ ? std::make_unique<SubObjectHooks>(*other.hooks_) : nullptr) {}
+
+SubObject& SubObject::operator=(const SubObject& other) {
+  if (this != &other) *this = SubObject(other);
+  return *this;
+}
+
+void SubObject::AddReadHook(ReadHook hook) {
+  if (!hooks_) hooks_ = std::make_unique<SubObjectHooks>();
+  hooks_->read_hooks.push_back(std::move(hook));
+}
+
+void SubObject::AddValidator(WriteValidator validator) {
+  if (!hooks_) hooks_ = std::make_unique<SubObjectHooks>();
+  hooks_->validators.push_back(std::move(validator));
+}
+
+void SubObject::AddListener(WriteListener listener) {
+  if (!hooks_) hooks_ = std::make_unique<SubObjectHooks>();
+  hooks_->listeners.push_back(std::move(listener));
+}
+
+std::span<const ReadHook> SubObject::read_hooks() const {
+  return hooks_ ? std::span<const ReadHook>(hooks_->read_hooks) : std::span<const ReadHook>();
+}
+
+std::span<const WriteValidator> SubObject::validators() const {
+  return hooks_ ? std::span<const WriteValidator>(hooks_->validators) : std::span<const WriteValidator>();
+}
+
+std::span<const WriteListener> SubObject::listeners() const {
+  return hooks_ ? std::span<const WriteListener>(hooks_->listeners) : std::span<const WriteListener>();
 }
 
 std::uint32_t SubObject::BitLength() const {
@@ -94,7 +141,7 @@ SdoAbort ObjectDictionary::Read(std::uint16_t index, std::uint8_t sub_index, Byt
   SubObject* sub = nullptr;
   if (auto rc = Lookup(index, sub_index, sub); rc != SdoAbort::kNone) return rc;
   if (origin == Origin::kSdo && !IsReadable(sub->access)) return SdoAbort::kWriteOnly;
-  for (auto& hook : sub->read_hooks) {
+  for (const auto& hook : sub->read_hooks()) {
     if (auto rc = hook(*sub, origin); rc != SdoAbort::kNone) return rc;
   }
   out = sub->value;
@@ -122,15 +169,21 @@ SdoAbort ObjectDictionary::Write(SubObject& sub, std::span<const std::uint8_t> d
         return SdoAbort::kValueTooHigh;
       if (sub.low_limit && CompareNumeric(sub.type, data, *sub.low_limit) < 0) return SdoAbort::kValueTooLow;
     }
-    for (auto& validate : sub.validators) {
+    for (const auto& validate : sub.validators()) {
       if (auto rc = validate(sub, data, origin); rc != SdoAbort::kNone) return rc;
     }
   }
   // assign() reuses the existing buffer when the size does not grow: no allocation per RPDO.
   sub.value.assign(data.begin(), data.end());
-  for (auto& listener : sub.listeners)
-    listener(sub, origin);
+  Committed(sub, origin);
   return SdoAbort::kNone;
+}
+
+void ObjectDictionary::Committed(SubObject& sub, Origin origin) {
+  for (const auto& listener : sub.listeners())
+    listener(sub, origin);
+  for (const auto& listener : write_listeners_)
+    listener(sub, origin);
 }
 
 std::uint64_t ObjectDictionary::GetUnsigned(std::uint16_t index, std::uint8_t sub) const {
@@ -162,9 +215,8 @@ void ObjectDictionary::RestoreDefaults(std::uint16_t first, std::uint16_t last, 
     for (auto& [sub_index, sub] : it->second.subs) {
       auto def = sub.DefaultFor(node_id);
       if (sub.value == def) continue;
-      sub.value = std::move(def);
-      for (auto& listener : sub.listeners)
-        listener(sub, Origin::kDevice);
+      sub.value = def;
+      Committed(sub, Origin::kDevice);
     }
   }
 }

@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "node/canopen/od/abort_code.hpp"
+#include "node/canopen/od/small_bytes.hpp"
 #include "node/canopen/od/types.hpp"
 #include "node/canopen/od/value.hpp"
 
@@ -33,29 +35,54 @@ using WriteValidator =
 /// Called after a write was committed.
 using WriteListener = std::function<void(SubObject& sub, Origin origin)>;
 
-/// One sub-index of an object (a VAR object has exactly one, at sub-index 0).
-struct SubObject {
-  std::uint16_t index = 0;
-  std::uint8_t sub_index = 0;
-  std::string name;
-  DataType type = DataType::kUnsigned8;
-  Access access = Access::kRw;
-  bool pdo_mappable = false;
-  std::optional<Bytes> low_limit;     ///< encoded like the value
-  std::optional<Bytes> high_limit;    ///< encoded like the value
-  Bytes default_value;                ///< encoded; node-ID not yet added (see default_adds_node_id)
-  bool default_adds_node_id = false;  ///< EDS "$NODEID+x": the node-ID is added when applied
-  Bytes value;                        ///< the current value, encoded
-  std::uint32_t obj_flags = 0;        ///< CiA 306 ObjFlags, kept for round trips
-
+/// The hooks of one sub-object. Most sub-objects have none, so they live in their own allocation,
+/// made when the first is added (idle RSS, bench/idle/README.md).
+struct SubObjectHooks {
   std::vector<ReadHook> read_hooks;
   std::vector<WriteValidator> validators;
   std::vector<WriteListener> listeners;
+};
+
+/// One sub-index of an object (a VAR object has exactly one, at sub-index 0).
+struct SubObject {
+  // Small fields first, packed: a valve controller has 2500 sub-objects.
+  std::uint16_t index = 0;
+  std::uint8_t sub_index = 0;
+  Access access = Access::kRw;
+  DataType type = DataType::kUnsigned8;
+  bool pdo_mappable = false;
+  bool default_adds_node_id = false;  ///< EDS "$NODEID+x": the node-ID is added when applied
+  std::uint32_t obj_flags = 0;        ///< CiA 306 ObjFlags, kept for round trips
+  std::string name;
+  std::optional<SmallBytes> low_limit;   ///< encoded like the value
+  std::optional<SmallBytes> high_limit;  ///< encoded like the value
+  SmallBytes default_value;              ///< encoded; node-ID not yet added (see default_adds_node_id)
+  SmallBytes value;                      ///< the current value, encoded
+
+  SubObject() = default;
+  SubObject(const SubObject& other);
+  SubObject(SubObject&&) noexcept = default;
+  SubObject& operator=(const SubObject& other);
+  SubObject& operator=(SubObject&&) noexcept = default;
+  ~SubObject() = default;
+
+  /// Computes or refreshes the value before each read; runs in the order added.
+  void AddReadHook(ReadHook hook);
+  /// Vetoes a write (SDO and PDO origins); runs in the order added.
+  void AddValidator(WriteValidator validator);
+  /// Reacts after a committed write; runs in the order added, before the dictionary's listeners.
+  void AddListener(WriteListener listener);
+  std::span<const ReadHook> read_hooks() const;
+  std::span<const WriteValidator> validators() const;
+  std::span<const WriteListener> listeners() const;
 
   /// The default with the node-ID applied, encoded like the value.
   Bytes DefaultFor(std::uint8_t node_id) const;
   /// Size in bits for PDO mapping (8 × byte size for fixed types, 0 for variable-length types).
   std::uint32_t BitLength() const;
+
+ private:
+  std::unique_ptr<SubObjectHooks> hooks_;  ///< null until a hook is added
 };
 
 /// A sub-object with its current value set to its default (sub-index and index are filled in
@@ -113,6 +140,13 @@ class ObjectDictionary {
   /// Borrowed objects are left alone: their owner restores them.
   void RestoreDefaults(std::uint16_t first, std::uint16_t last, std::uint8_t node_id);
 
+  /// Adds a listener that runs after every committed write through this dictionary, to any
+  /// sub-object (borrowed ones too), after the sub-object's own listeners; RestoreDefaults runs it
+  /// for every value it changes. For reactions to "any write" (waking a device's application):
+  /// one listener instead of one per sub-object. A device with borrowed objects adds it to each
+  /// dictionary that serves them.
+  void AddWriteListener(WriteListener listener) { write_listeners_.push_back(std::move(listener)); }
+
   /// Serves `object`, owned by another dictionary, at its index (replacing an own object there):
   /// one object seen through two dictionaries, as the application objects of a device with two
   /// CAN ports (data logger UMAX181001 §1.1: "2 CAN interfaces which share manufacturer-specific
@@ -127,8 +161,11 @@ class ObjectDictionary {
   Objects& objects() { return objects_; }
 
  private:
+  void Committed(SubObject& sub, Origin origin);
+
   Objects objects_;
   std::map<std::uint16_t, Object*> borrowed_;
+  std::vector<WriteListener> write_listeners_;
 };
 
 }  // namespace canfleet::canopen

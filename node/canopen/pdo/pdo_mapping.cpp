@@ -53,7 +53,7 @@ void PdoMapping::Pack(std::array<std::uint8_t, 8>& data) const {
   std::uint64_t frame = 0;
   for (const auto& e : entries_) {
     if (!e.sub || e.length == 0) continue;
-    for (auto& hook : e.sub->read_hooks)
+    for (const auto& hook : e.sub->read_hooks())
       (void)hook(*e.sub, Origin::kPdo);
     frame |= (DecodeUnsignedLe(e.sub->value) & Mask(e.length)) << e.offset;
   }

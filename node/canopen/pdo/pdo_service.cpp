@@ -35,17 +35,17 @@ void PdoService::InstallHooks(Pdo& pdo) {
   auto reconfigure = [&pdo](SubObject&, Origin) { pdo.Reconfigure(); };
   for (auto& [sub_index, sub] : pdo.config().comm_record().subs) {
     if (sub_index == 0) continue;
-    sub.validators.push_back([&pdo](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+    sub.AddValidator([&pdo](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
       return pdo.config().CheckCommWrite(s.sub_index, data);
     });
-    sub.listeners.push_back(reconfigure);
+    sub.AddListener(reconfigure);
   }
   if (Object* mapping = pdo.config().mapping_record()) {
     for (auto& [sub_index, sub] : mapping->subs) {
-      sub.validators.push_back([&pdo](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+      sub.AddValidator([&pdo](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         return pdo.config().CheckMappingWrite(s.sub_index, data);
       });
-      sub.listeners.push_back(reconfigure);
+      sub.AddListener(reconfigure);
     }
   }
 }

@@ -97,7 +97,7 @@ void SdoServer::WatchParameterObject() {
   for (std::uint8_t i = 0; i < 2; ++i) {
     SubObject* sub = od_.Find(kServerParameter, static_cast<std::uint8_t>(i + 1));
     if (!sub || sub == watched_[i]) continue;
-    sub->listeners.push_back([this](SubObject&, Origin) { FollowParameterObject(); });
+    sub->AddListener([this](SubObject&, Origin) { FollowParameterObject(); });
     watched_[i] = sub;
   }
 }

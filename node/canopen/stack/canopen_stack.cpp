@@ -127,7 +127,7 @@ void CanopenStack::RefuseStorageWithoutStateDir() {
     if (!object) continue;
     for (auto& [sub_index, sub] : object->subs) {
       if (sub_index == 0) continue;
-      sub.validators.push_back(
+      sub.AddValidator(
           [](const SubObject&, std::span<const std::uint8_t>, Origin) { return SdoAbort::kCannotTransfer; });
     }
   }

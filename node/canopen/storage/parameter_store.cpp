@@ -127,13 +127,13 @@ void ParameterStore::InstallHooks(std::uint16_t index, std::uint32_t signature) 
   };
   for (auto& [sub_index, sub] : object->subs) {
     if (sub_index == 0) continue;
-    sub.validators.push_back(
+    sub.AddValidator(
         [this, signature, store](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
           if (data.size() != 4 || DecodeUnsignedLe(data) != signature) return SdoAbort::kCannotTransfer;
           return store ? Save(s.sub_index) : MarkRestoreDefaults(s.sub_index);
         });
-    sub.listeners.push_back([read_as_one](SubObject& s, Origin) { read_as_one(s); });
-    sub.read_hooks.push_back([read_as_one](SubObject& s, Origin) {
+    sub.AddListener([read_as_one](SubObject& s, Origin) { read_as_one(s); });
+    sub.AddReadHook([read_as_one](SubObject& s, Origin) {
       read_as_one(s);
       return SdoAbort::kNone;
     });

@@ -21,19 +21,19 @@ SyncService::SyncService(ObjectDictionary& od, BusPort& port, Scheduler& schedul
       producer_timer_(scheduler, [this] { Produce(); }) {
   auto reconfigure = [this](SubObject&, Origin) { Configure(); };
   if (cob_id_) {
-    cob_id_->validators.push_back([](const SubObject& sub, std::span<const std::uint8_t> data, Origin) {
+    cob_id_->AddValidator([](const SubObject& sub, std::span<const std::uint8_t> data, Origin) {
       return CheckSyncCobIdWrite(static_cast<std::uint32_t>(DecodeUnsignedLe(sub.value)),
                                  static_cast<std::uint32_t>(DecodeUnsignedLe(data)));
     });
-    cob_id_->listeners.push_back(reconfigure);
+    cob_id_->AddListener(reconfigure);
   }
   if (overflow_) {
-    overflow_->validators.push_back([this](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+    overflow_->AddValidator([this](const SubObject&, std::span<const std::uint8_t> data, Origin) {
       return CheckSyncCounterOverflowWrite(static_cast<std::uint8_t>(DecodeUnsignedLe(data)), PeriodUs());
     });
-    overflow_->listeners.push_back(reconfigure);
+    overflow_->AddListener(reconfigure);
   }
-  if (period_) period_->listeners.push_back(reconfigure);
+  if (period_) period_->AddListener(reconfigure);
   Configure();
 }
 

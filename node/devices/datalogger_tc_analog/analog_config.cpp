@@ -38,8 +38,8 @@ SubObject& Entry(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub) {
 void Validate(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub,
               std::function<SdoAbort(std::int64_t value)> check) {
   Entry(od, index, sub)
-      .validators.push_back([check = std::move(check)](const SubObject& s, std::span<const std::uint8_t> data,
-                                                       Origin) { return check(Decode(s, data)); });
+      .AddValidator([check = std::move(check)](const SubObject& s, std::span<const std::uint8_t> data,
+                                               Origin) { return check(Decode(s, data)); });
 }
 
 // Input number (1-based) of channel `ch`.

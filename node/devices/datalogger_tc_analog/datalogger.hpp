@@ -36,11 +36,12 @@
 #include "node/devices/datalogger_tc_analog/program_blocks.hpp"
 #include "node/devices/datalogger_tc_analog/thermocouple_block.hpp"
 #include "node/devices/device.hpp"
+#include "node/devices/embedded_eds.hpp"
 
 namespace canfleet::devices {
 
-/// The text of datalogger-tc-analog.eds, generated from the dictionary table and compiled in.
-std::string_view DataLoggerEdsText();
+/// datalogger-tc-analog.eds, generated from datalogger-tc-analog.od by the build and compiled in deflated.
+EmbeddedEds DataLoggerEds();
 
 class DataLogger final : public Device {
  public:

@@ -219,16 +219,16 @@ void ProgramBlocks::InstallHooks(ObjectDictionary& od) {
     };
   };
   for (TableSlot& t : tables_)
-    t.number.sub().validators.push_back(number_rule(t.source));
+    t.number.sub().AddValidator(number_rule(t.source));
   for (MathSlot& m : maths_) {
     for (MathInput& in : m.inputs)
-      in.number.sub().validators.push_back(number_rule(in.source));
+      in.number.sub().AddValidator(number_rule(in.source));
   }
   for (LogicSlot& l : logics_) {
     for (auto& function : l.conditions) {
       for (Condition& c : function) {
-        c.arg1_number.sub().validators.push_back(number_rule(c.arg1_source));
-        c.arg2_number.sub().validators.push_back(number_rule(c.arg2_source));
+        c.arg1_number.sub().AddValidator(number_rule(c.arg1_source));
+        c.arg2_number.sub().AddValidator(number_rule(c.arg2_source));
       }
     }
   }
@@ -237,7 +237,7 @@ void ProgramBlocks::InstallHooks(ObjectDictionary& od) {
   for (TableSlot& table : tables_) {
     TableSlot* t = &table;
     for (std::size_t k = 0; k < kLutPoints; ++k) {
-      t->x[k].sub().validators.push_back(
+      t->x[k].sub().AddValidator(
           [this, t, k](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
             const std::int64_t v = Decode(s, data);
             if (t->x_type.Get() == 1) {
@@ -263,7 +263,7 @@ void ProgramBlocks::InstallHooks(ObjectDictionary& od) {
     }
     // §1.5.4: with a time response "3yz3h ... is automatically set to 0" and point 1 "is
     // automatically set to [0,0]".
-    t->x_type.sub().listeners.push_back([t, &od](SubObject& s, Origin origin) {
+    t->x_type.sub().AddListener([t, &od](SubObject& s, Origin origin) {
       if (origin == Origin::kDevice || canopen::DecodeUnsignedLe(s.value) != 1) return;
       const std::uint16_t base = static_cast<std::uint16_t>(s.index - kLutResponse);
       OdRef(od, base + kLutXDigits, 0).Set(0);
@@ -277,10 +277,10 @@ void ProgramBlocks::InstallHooks(ObjectDictionary& od) {
     const auto sub = static_cast<std::uint8_t>(n);
     OdRef low(od, kReceivedScaling1, sub);
     OdRef high(od, kReceivedScaling2, sub);
-    low.sub().validators.push_back([high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+    low.sub().AddValidator([high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
       return Decode(s, data) < high.Get() ? SdoAbort::kNone : SdoAbort::kValueTooHigh;
     });
-    high.sub().validators.push_back([low](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+    high.sub().AddValidator([low](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
       return Decode(s, data) > low.Get() ? SdoAbort::kNone : SdoAbort::kValueTooLow;
     });
   }

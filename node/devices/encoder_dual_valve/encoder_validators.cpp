@@ -26,7 +26,7 @@ SubObject& Entry(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub) {
 }
 
 void AllowOnly(SubObject& sub, std::vector<std::int64_t> allowed) {
-  sub.validators.push_back(
+  sub.AddValidator(
       [allowed = std::move(allowed)](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         return std::find(allowed.begin(), allowed.end(), Decode(s, data)) != allowed.end()
                    ? SdoAbort::kNone
@@ -35,7 +35,7 @@ void AllowOnly(SubObject& sub, std::vector<std::int64_t> allowed) {
 }
 
 void Between(SubObject& sub, std::int64_t low, std::int64_t high) {
-  sub.validators.push_back([low, high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+  sub.AddValidator([low, high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
     const auto v = Decode(s, data);
     if (v < low) return SdoAbort::kValueTooLow;
     if (v > high) return SdoAbort::kValueTooHigh;
@@ -44,7 +44,7 @@ void Between(SubObject& sub, std::int64_t low, std::int64_t high) {
 }
 
 void OnNetworkWrite(SubObject& sub, std::function<void()> action) {
-  sub.listeners.push_back([action = std::move(action)](SubObject&, Origin origin) {
+  sub.AddListener([action = std::move(action)](SubObject&, Origin origin) {
     if (origin != Origin::kDevice) action();
   });
 }
@@ -61,14 +61,14 @@ void InstallPair(ObjectDictionary& od, const blocks::ControlSources& sources, co
   ObjectDictionary* dict = &od;
   const blocks::ControlSources* table = &sources;
   Entry(od, p.source_index, p.source_sub)
-      .validators.push_back([dict, table, p](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+      .AddValidator([dict, table, p](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         const auto code = static_cast<std::uint8_t>(Decode(s, data));
         if (!table->IsSourceAllowed(code)) return SdoAbort::kValueTooHigh;
         const auto number = static_cast<std::uint8_t>(dict->GetUnsigned(p.number_index, p.number_sub));
         return table->IsAllowed({code, number}) ? SdoAbort::kNone : SdoAbort::kParameterIncompatible;
       });
   Entry(od, p.number_index, p.number_sub)
-      .validators.push_back([dict, table, p](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+      .AddValidator([dict, table, p](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         const auto code = static_cast<std::uint8_t>(dict->GetUnsigned(p.source_index, p.source_sub));
         const blocks::SourceType* type = table->Find(code);
         if (!type || type->number_ignored) return SdoAbort::kNone;
@@ -143,7 +143,7 @@ void InstallEncoderValidators(canopen::CanopenStack& stack, const blocks::Contro
     AllowOnly(Entry(od, kAiSensorType, sub), {60, 10000, 10002});
     AllowOnly(Entry(od, kAiOperatingMode, sub), {0, 1, 10});
     Entry(od, kAiRange, sub)
-        .validators.push_back([dict, sub](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+        .AddValidator([dict, sub](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
           const auto max = MaxRange(static_cast<std::uint16_t>(dict->GetUnsigned(kAiSensorType, sub)),
                                     static_cast<std::uint8_t>(dict->GetUnsigned(kAiOperatingMode, sub)));
           return Decode(s, data) > max ? SdoAbort::kValueTooHigh : SdoAbort::kNone;
@@ -187,7 +187,7 @@ void InstallEncoderValidators(canopen::CanopenStack& stack, const blocks::Contro
 
   // 1.8: setpoint control locks the target to a control constant.
   Entry(od, kPidTargetSource, 0)
-      .validators.push_back([dict](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+      .AddValidator([dict](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         const bool setpoint = dict->GetUnsigned(kPidResponse, 0) == 1;
         return setpoint && Decode(s, data) != 9 ? SdoAbort::kDeviceState : SdoAbort::kNone;
       });
@@ -203,7 +203,7 @@ void InstallEncoderValidators(canopen::CanopenStack& stack, const blocks::Contro
   // 1.5: "Sub-index 1 is fixed as FALSE (0) and sub-index 2 is always TRUE (1)".
   for (std::uint8_t sub : {std::uint8_t{1}, std::uint8_t{2}}) {
     SubObject& constant = Entry(od, kConstants, sub);
-    constant.validators.push_back(
+    constant.AddValidator(
         [fixed = constant.default_value](const SubObject&, std::span<const std::uint8_t> data, Origin) {
           return std::equal(data.begin(), data.end(), fixed.begin(), fixed.end()) ? SdoAbort::kNone
                                                                                   : SdoAbort::kInvalidValue;

@@ -42,7 +42,7 @@ EncoderValveController::~EncoderValveController() {
 
 void EncoderValveController::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(EncoderEdsText(), "encoder-dual-valve.eds", options_.eds);
+  od = LoadVariantDictionary(EncoderEds(), "encoder-dual-valve.eds", options_.eds);
   od_ = &od;
 }
 
@@ -86,7 +86,7 @@ void EncoderValveController::Attach(DeviceContext& context) {
   // A moving count is sampled when a client reads it (SDO upload, TPDO).
   for (int ch = 0; ch < kInputs; ++ch) {
     for (std::uint16_t index : {kAiFieldValue, kAiProcessValue}) {
-      OdRef(od, index, SubOf(ch)).sub().read_hooks.push_back([this, ch](canopen::SubObject&, Origin) {
+      OdRef(od, index, SubOf(ch)).sub().AddReadHook([this, ch](canopen::SubObject&, Origin) {
         inputs_->SampleOnRead(ch, scheduler_->Now());
         return canopen::SdoAbort::kNone;
       });
@@ -106,7 +106,7 @@ void EncoderValveController::InstallWakeListeners() {
   for (auto it = objects.lower_bound(0x2000); it != objects.end() && it->first <= 0x7FFF; ++it) {
     for (auto& [sub_index, sub] : it->second.subs) {
       (void)sub_index;
-      sub.listeners.push_back([this](canopen::SubObject&, Origin origin) {
+      sub.AddListener([this](canopen::SubObject&, Origin origin) {
         if (origin != Origin::kDevice) Wake();
       });
     }

@@ -19,12 +19,13 @@
 #include <string_view>
 
 #include "node/devices/device.hpp"
+#include "node/devices/embedded_eds.hpp"
 #include "node/devices/encoder_dual_valve/encoder_io.hpp"
 
 namespace canfleet::devices {
 
-/// The text of encoder-dual-valve.eds, generated from encoder-dual-valve.od by the build.
-std::string_view EncoderEdsText();
+/// encoder-dual-valve.eds, generated from encoder-dual-valve.od by the build and compiled in deflated.
+EmbeddedEds EncoderEds();
 
 namespace encoder {
 class EncoderSources;

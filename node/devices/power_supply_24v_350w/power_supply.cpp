@@ -49,7 +49,7 @@ void PowerSupply::DeclareSignals(SimulatedIo& io) {
 
 void PowerSupply::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(PowerSupplyEdsText(), kEdsFileName, options_.eds);
+  od = LoadVariantDictionary(PowerSupplyEds(), kEdsFileName, options_.eds);
   od_ = &od;
 }
 
@@ -154,21 +154,21 @@ void PowerSupply::InstallListeners() {
   const auto u8 = [](const canopen::SubObject& sub) {
     return static_cast<std::uint8_t>(canopen::DecodeUnsignedLe(sub.value));
   };
-  OdRef(od, kOutputCommands, 2).sub().listeners.push_back([this, u8](canopen::SubObject& sub, Origin origin) {
+  OdRef(od, kOutputCommands, 2).sub().AddListener([this, u8](canopen::SubObject& sub, Origin origin) {
     if (origin != Origin::kDevice) control_->OnCanCommand(u8(sub));
   });
   for (auto [index, sub_index] :
        {std::pair{kOutputCommands, std::uint8_t{3}}, std::pair{kGeneralCommands, std::uint8_t{2}}}) {
-    OdRef(od, index, sub_index).sub().listeners.push_back([this, u8](canopen::SubObject& sub, Origin origin) {
+    OdRef(od, index, sub_index).sub().AddListener([this, u8](canopen::SubObject& sub, Origin origin) {
       if (origin != Origin::kDevice && u8(sub) == kQuitFailure) control_->OnQuitFailure();
     });
   }
-  OdRef(od, kShutdownAck, 0).sub().listeners.push_back([this, u8](canopen::SubObject& sub, Origin origin) {
+  OdRef(od, kShutdownAck, 0).sub().AddListener([this, u8](canopen::SubObject& sub, Origin origin) {
     if (origin != Origin::kDevice) control_->OnShutdownAck(u8(sub), scheduler_->Now());
   });
   // A new filter type or constant starts the filter over from its present value.
   for (std::uint16_t index : {kInputFilterType, kInputFilterConstant}) {
-    OdRef(od, index, 1).sub().listeners.push_back([this](canopen::SubObject&, Origin) {
+    OdRef(od, index, 1).sub().AddListener([this](canopen::SubObject&, Origin) {
       filter_.Reset(filter_.Value());
     });
   }

@@ -28,6 +28,7 @@
 #include "node/devices/blocks/input_filter.hpp"
 #include "node/devices/delayed_fault.hpp"
 #include "node/devices/device.hpp"
+#include "node/devices/embedded_eds.hpp"
 #include "node/devices/od_ref.hpp"
 #include "node/devices/periodic_tick.hpp"
 #include "node/devices/power_supply_24v_350w/failure_status.hpp"
@@ -38,8 +39,8 @@
 
 namespace canfleet::devices {
 
-/// The text of power-supply-24v-350w.eds, generated from the dictionary table and compiled in.
-std::string_view PowerSupplyEdsText();
+/// power-supply-24v-350w.eds, generated from power-supply-24v-350w.od by the build and compiled in deflated.
+EmbeddedEds PowerSupplyEds();
 
 class PowerSupply final : public Device {
  public:

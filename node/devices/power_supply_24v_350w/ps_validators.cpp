@@ -25,7 +25,7 @@ SubObject& Entry(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub) {
 }
 
 void AllowOnly(SubObject& sub, std::vector<std::int64_t> allowed) {
-  sub.validators.push_back(
+  sub.AddValidator(
       [allowed = std::move(allowed)](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         return std::find(allowed.begin(), allowed.end(), Decode(s, data)) != allowed.end()
                    ? SdoAbort::kNone
@@ -43,7 +43,7 @@ void InstallPsValidators(canopen::CanopenStack& stack) {
   for (std::uint8_t sub = 1; sub <= 4; ++sub) {
     if (!od.Find(0x1029, sub)) continue;
     Entry(od, 0x1029, sub)
-        .validators.push_back([node](const SubObject&, std::span<const std::uint8_t>, Origin origin) {
+        .AddValidator([node](const SubObject&, std::span<const std::uint8_t>, Origin origin) {
           return origin != Origin::kDevice && node->emcy().ErrorRegister() != 0 ? SdoAbort::kDeviceState
                                                                                 : SdoAbort::kNone;
         });
@@ -61,18 +61,18 @@ void InstallPsValidators(canopen::CanopenStack& stack) {
   ObjectDictionary* dict = &od;
   for (std::uint8_t n = 1; n <= 10; ++n) {
     Entry(od, kScaling1, n)
-        .validators.push_back([dict, n](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+        .AddValidator([dict, n](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
           return Decode(s, data) >= dict->GetSigned(kScaling2, n) ? SdoAbort::kValueTooHigh : SdoAbort::kNone;
         });
     Entry(od, kScaling2, n)
-        .validators.push_back([dict, n](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+        .AddValidator([dict, n](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
           return Decode(s, data) <= dict->GetSigned(kScaling1, n) ? SdoAbort::kValueTooLow : SdoAbort::kNone;
         });
   }
 
   AllowOnly(Entry(od, kChangeBaudRate, 0), {0, 1, 2, 3, 4, 6, 7, 8});
   Entry(od, kChangeNodeId, 0)
-      .validators.push_back([](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+      .AddValidator([](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         const auto id = Decode(s, data);
         if (id < 1) return SdoAbort::kValueTooLow;
         if (id > 127) return SdoAbort::kValueTooHigh;

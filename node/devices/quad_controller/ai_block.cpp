@@ -74,11 +74,11 @@ AiBlock::AiBlock(canopen::CanopenStack& stack, Scheduler& scheduler, const QuadI
         scheduler, stack, MakeErrorEntry(kEmcyInputHigh, kDescAnalogInput, sub), kBehaviourAnalogInput);
 
     SubObject& autozero = OdRef(od, kAiAutozero, sub).sub();
-    autozero.validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+    autozero.AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
       return canopen::DecodeUnsignedLe(data) == kZeroSignature ? SdoAbort::kNone : SdoAbort::kInvalidValue;
     });
     // Only a network write is a command; stored or restored values are not (and 6125h is not stored).
-    autozero.listeners.push_back([this, ch](SubObject&, Origin origin) {
+    autozero.AddListener([this, ch](SubObject&, Origin origin) {
       if (origin != Origin::kDevice) Autozero(ch);
     });
   }

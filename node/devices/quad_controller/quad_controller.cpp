@@ -15,7 +15,7 @@ QuadController::~QuadController() = default;
 
 void QuadController::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(QuadControllerEdsText(), "quad-controller.eds", options_.eds);
+  od = LoadVariantDictionary(QuadControllerEds(), "quad-controller.eds", options_.eds);
   od_ = &od;
 }
 

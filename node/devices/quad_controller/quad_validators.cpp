@@ -34,7 +34,7 @@ SubObject& Entry(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub) {
 }
 
 void AllowOnly(SubObject& sub, std::vector<std::int64_t> allowed) {
-  sub.validators.push_back(
+  sub.AddValidator(
       [allowed = std::move(allowed)](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
         return std::find(allowed.begin(), allowed.end(), Decode(s, data)) != allowed.end()
                    ? SdoAbort::kNone
@@ -45,7 +45,7 @@ void AllowOnly(SubObject& sub, std::vector<std::int64_t> allowed) {
 /// Accepts [low(), high()] evaluated at write time.
 template <typename Low, typename High>
 void Between(SubObject& sub, Low low, High high) {
-  sub.validators.push_back([low, high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+  sub.AddValidator([low, high](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
     const auto v = Decode(s, data);
     if (v < low()) return SdoAbort::kValueTooLow;
     if (v > high()) return SdoAbort::kValueTooHigh;
@@ -108,7 +108,7 @@ void InstallQuadValidators(canopen::CanopenStack& stack) {
     AllowOnly(Entry(od, kAoRampControl, sub), {0, 1, 2});
     AllowOnly(Entry(od, kAoOutputType, sub), {20, 1000});
     Entry(od, kAoFieldValue, sub)
-        .validators.push_back([dict, sub](const SubObject&, std::span<const std::uint8_t>, Origin) {
+        .AddValidator([dict, sub](const SubObject&, std::span<const std::uint8_t>, Origin) {
           return ValueOf(*dict, kReceivedPvStatus, sub) == 1 ? SdoAbort::kDeviceState : SdoAbort::kNone;
         });
   }
@@ -119,10 +119,10 @@ void InstallQuadValidators(canopen::CanopenStack& stack) {
     return origin == Origin::kSdo && node->State() != NmtState::kOperational ? SdoAbort::kDeviceState
                                                                              : SdoAbort::kNone;
   };
-  Entry(od, kDoWriteState, 1).validators.push_back(refuse_in_pre_operational);
+  Entry(od, kDoWriteState, 1).AddValidator(refuse_in_pre_operational);
   for (int n = 0; n < kPouts; ++n) {
     for (std::uint16_t index : {kAoFieldValue, kReceivedPv, kReceivedPvStatus})
-      Entry(od, index, SubOf(n)).validators.push_back(refuse_in_pre_operational);
+      Entry(od, index, SubOf(n)).AddValidator(refuse_in_pre_operational);
   }
 }
 

@@ -36,7 +36,7 @@ ValveController::~ValveController() {
 
 void ValveController::Build(std::size_t port, canopen::ObjectDictionary& od) {
   (void)port;
-  od = LoadVariantDictionary(ValveEdsText(), kEdsFileName, options_.eds);
+  od = LoadVariantDictionary(ValveEds(), kEdsFileName, options_.eds);
   od_ = &od;
 }
 
@@ -94,14 +94,11 @@ void ValveController::Attach(DeviceContext& context) {
   io_subscription_ = io_.Subscribe([this](const IoSignal& signal) {
     if (signal.direction() == IoDirection::kInput) RequestRun();
   });
-  for (auto& [index, object] : od.objects()) {
-    if (index < 0x2000 || index > 0x7FFF) continue;
-    for (auto& [sub_index, sub] : object.subs) {
-      sub.listeners.push_back([this](SubObject&, Origin origin) {
-        if (origin != Origin::kDevice) RequestRun();
-      });
-    }
-  }
+  // One listener for the dictionary rather than one per application sub-object (2400 of them,
+  // ~130 bytes each of idle RSS).
+  od.AddWriteListener([this](SubObject& sub, Origin origin) {
+    if (origin != Origin::kDevice && sub.index >= 0x2000 && sub.index <= 0x7FFF) RequestRun();
+  });
   last_run_ = FloorMs(context.scheduler.Now());
   RequestRun();
 }

@@ -23,12 +23,13 @@
 #include <string_view>
 
 #include "node/devices/device.hpp"
+#include "node/devices/embedded_eds.hpp"
 #include "node/devices/valve_12in12out/valve_io.hpp"
 
 namespace canfleet::devices {
 
-/// The EDS generated from valve-12in12out.od, compiled in.
-std::string_view ValveEdsText();
+/// valve-12in12out.eds, generated from valve-12in12out.od by the build and compiled in deflated.
+EmbeddedEds ValveEds();
 
 namespace valve {
 class InputBlock;

@@ -39,8 +39,9 @@ SubObject& Entry(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub) {
 void Check(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub,
            std::function<SdoAbort(std::int64_t)> rule) {
   Entry(od, index, sub)
-      .validators.push_back([rule = std::move(rule)](const SubObject& s, std::span<const std::uint8_t> data,
-                                                     Origin) { return rule(Decode(s, data)); });
+      .AddValidator([rule = std::move(rule)](const SubObject& s, std::span<const std::uint8_t> data, Origin) {
+        return rule(Decode(s, data));
+      });
 }
 
 /// [low, high] with the abort code for each side.
@@ -52,7 +53,7 @@ SdoAbort Within(double v, double low, double high) {
 
 /// After an SDO (or PDO) write only: the device's own writes and stored values never cascade.
 void OnWrite(ObjectDictionary& od, std::uint16_t index, std::uint8_t sub, std::function<void()> action) {
-  Entry(od, index, sub).listeners.push_back([action = std::move(action)](SubObject&, Origin origin) {
+  Entry(od, index, sub).AddListener([action = std::move(action)](SubObject&, Origin origin) {
     if (origin != Origin::kDevice) action();
   });
 }

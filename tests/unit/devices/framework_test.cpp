@@ -114,11 +114,11 @@ class TwoPortDevice final : public Device {
   }
   void Attach(DeviceContext& context) override {
     auto& od = context.stacks[0]->od();
-    od.Find(0x2000, 0)->validators.push_back(
+    od.Find(0x2000, 0)->AddValidator(
         [](const canopen::SubObject&, std::span<const std::uint8_t> d, canopen::Origin) {
           return d[0] % 2 == 0 ? canopen::SdoAbort::kNone : canopen::SdoAbort::kInvalidValue;
         });
-    od.Find(0x2000, 0)->listeners.push_back([this](canopen::SubObject&, canopen::Origin) { ++changes; });
+    od.Find(0x2000, 0)->AddListener([this](canopen::SubObject&, canopen::Origin) { ++changes; });
     measured = OdRef(od, 0x6000, 0);
   }
   OdRef measured;

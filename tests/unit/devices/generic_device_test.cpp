@@ -149,7 +149,7 @@ TEST(DeviceCatalogTest, AnEntryGivesSignalsDictionaryAndPortsWithoutADevice) {
   const canopen::ObjectDictionary od = VariantDictionary(*quad);
   EXPECT_EQ(od.GetUnsigned(0x1018, 2), 0xAA020502u);  // AX020506 §3.1, 1018h sub 2
   EXPECT_EQ(MakeDevice({"quad-controller", {}})->PortCount(), quad->ports);
-  EXPECT_EQ(quad->eds_text().substr(0, 10), "[FileInfo]");
+  EXPECT_EQ(quad->eds().Text().substr(0, 10), "[FileInfo]");
 }
 
 // CiA 305 §5.5 table 0: the bit timing index of each bit rate; 100 kbit/s (index 5) is reserved.

@@ -36,7 +36,7 @@ class QuadEdsTest : public ::testing::Test {
 
 // The compiled-in text is the file in the tree (users load the same file into their master).
 TEST_F(QuadEdsTest, TheCompiledInTextIsTheShippedFile) {
-  const EdsFile compiled = canopen::ParseEds(QuadControllerEdsText(), "quad-controller.eds");
+  const EdsFile compiled = canopen::ParseEds(QuadControllerEds().Text(), "quad-controller.eds");
   EXPECT_TRUE(canopen::DiffEdsFiles(compiled, Eds(), canopen::EdsFormat::kEds).empty());
 }
 

@@ -22,7 +22,7 @@ TEST(QuadTable, DescribesExactlyTheHandWrittenEds) {
 
 // The build compiles the EDS generated from the table into the node.
 TEST(QuadTable, TheNodeRunsOnTheGeneratedEds) {
-  const canopen::EdsFile compiled = canopen::ParseEds(QuadControllerEdsText(), "quad-controller.eds");
+  const canopen::EdsFile compiled = canopen::ParseEds(QuadControllerEds().Text(), "quad-controller.eds");
   const canopen::EdsFile table = ReadOdTable(CANFLEET_QUAD_TABLE);
   EXPECT_TRUE(canopen::DiffEdsFiles(compiled, table, canopen::EdsFormat::kEds).empty());
 }

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 namespace canfleet::canopen {
 namespace {
 
@@ -67,10 +70,10 @@ TEST_F(ObjectDictionaryTest, BooleanAcceptsOnlyZeroAndOne) {
 TEST_F(ObjectDictionaryTest, ValidatorsVetoAndListenersReact) {
   auto* sub = od.Find(0x1017, 0);
   int notified = 0;
-  sub->validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+  sub->AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
     return DecodeUnsignedLe(data) == 7 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
   });
-  sub->listeners.push_back([&](SubObject&, Origin) { ++notified; });
+  sub->AddListener([&](SubObject&, Origin) { ++notified; });
   EXPECT_EQ(od.Write(0x1017, 0, EncodeLe<std::uint16_t>(7)), SdoAbort::kInvalidValue);
   EXPECT_EQ(notified, 0);
   EXPECT_EQ(od.GetUnsigned(0x1017, 0), 0u);  // a vetoed write leaves the old value
@@ -80,14 +83,14 @@ TEST_F(ObjectDictionaryTest, ValidatorsVetoAndListenersReact) {
 
 TEST_F(ObjectDictionaryTest, ReadHooksComputeOrRefuse) {
   auto* sub = od.Find(0x1017, 0);
-  sub->read_hooks.push_back([](SubObject& s, Origin) {
+  sub->AddReadHook([](SubObject& s, Origin) {
     s.value = EncodeLe<std::uint16_t>(123);
     return SdoAbort::kNone;
   });
   Bytes out;
   ASSERT_EQ(od.Read(0x1017, 0, out), SdoAbort::kNone);
   EXPECT_EQ(DecodeUnsignedLe(out), 123u);
-  sub->read_hooks.push_back([](SubObject&, Origin) { return SdoAbort::kNoData; });
+  sub->AddReadHook([](SubObject&, Origin) { return SdoAbort::kNoData; });
   EXPECT_EQ(od.Read(0x1017, 0, out), SdoAbort::kNoData);
 }
 
@@ -127,6 +130,45 @@ TEST(Value, SignExtensionAndFormatting) {
   EXPECT_EQ(FormatValue(DataType::kReal32, EncodeLe<float>(1.5f)), "1.5");
   EXPECT_EQ(FormatValue(DataType::kVisibleString, ToBytes("ab")), "\"ab\"");
   EXPECT_EQ(FormatValue(DataType::kDomain, Bytes{0xDE, 0xAD}), "DEAD");
+}
+
+// Dictionary-wide write listeners: one for "any write" instead of one per sub-object (idle RSS).
+TEST(DictionaryWriteListenerTest, RunsAfterTheSubObjectsOwnListenersAndOnRestore) {
+  ObjectDictionary od;
+  auto& sub = od.AddVar(0x2000, "Value", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(7));
+  std::vector<std::string> calls;
+  sub.AddListener([&](SubObject&, Origin) { calls.push_back("sub"); });
+  od.AddWriteListener([&](SubObject& s, Origin origin) {
+    calls.push_back("od " + std::to_string(s.index) + (origin == Origin::kDevice ? " device" : " sdo"));
+  });
+  EXPECT_EQ(od.Write(0x2000, 0, EncodeLe<std::uint16_t>(9)), SdoAbort::kNone);
+  od.RestoreDefaults(0x1000, 0xFFFF, 1);
+  EXPECT_EQ(calls, (std::vector<std::string>{"sub", "od 8192 sdo", "sub", "od 8192 device"}));
+}
+
+TEST(DictionaryWriteListenerTest, SeesWritesToBorrowedObjects) {
+  ObjectDictionary owner, borrower;
+  owner.AddVar(0x2000, "Shared", DataType::kUnsigned8, Access::kRw, {0});
+  borrower.Borrow(*owner.Find(0x2000));
+  int heard = 0;
+  borrower.AddWriteListener([&](SubObject&, Origin) { ++heard; });
+  EXPECT_EQ(borrower.Write(0x2000, 0, std::vector<std::uint8_t>{5}), SdoAbort::kNone);
+  EXPECT_EQ(heard, 1);
+}
+
+TEST(SubObjectHooksTest, SubObjectWithoutHooksHasEmptyListsAndCopiesKeepHooks) {
+  ObjectDictionary od;
+  auto& sub = od.AddVar(0x2000, "Value", DataType::kUnsigned8, Access::kRw, {0});
+  EXPECT_TRUE(sub.read_hooks().empty());
+  EXPECT_TRUE(sub.validators().empty());
+  EXPECT_TRUE(sub.listeners().empty());
+  sub.AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+    return data[0] > 3 ? SdoAbort::kValueTooHigh : SdoAbort::kNone;
+  });
+  ObjectDictionary copy = od;
+  EXPECT_EQ(copy.Write(0x2000, 0, std::vector<std::uint8_t>{4}), SdoAbort::kValueTooHigh);
+  EXPECT_EQ(copy.Write(0x2000, 0, std::vector<std::uint8_t>{2}), SdoAbort::kNone);
+  EXPECT_EQ(od.GetUnsigned(0x2000, 0), 0u);  // the copy's value is its own
 }
 
 }  // namespace

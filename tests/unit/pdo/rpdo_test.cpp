@@ -19,7 +19,7 @@ TEST_F(RpdoTest, EventRpdoIsWrittenAtOnceAndListenersRun) {
   Start();
   MapRpdo1();
   std::vector<std::string> seen;
-  od.Find(0x7300, 1)->listeners.push_back([&](SubObject& sub, Origin origin) {
+  od.Find(0x7300, 1)->AddListener([&](SubObject& sub, Origin origin) {
     seen.push_back(std::to_string(DecodeSignedLe(sub.value)) + (origin == Origin::kPdo ? " pdo" : " other"));
   });
   Operational();
@@ -258,7 +258,7 @@ TEST_F(RpdoTest, RefusedObjectKeepsItsValue) {
   Start();
   MapRpdo1();
   od.Find(0x7300, 1)->high_limit = EncodeLe<std::int16_t>(1000);
-  od.Find(0x7300, 2)->validators.push_back(
+  od.Find(0x7300, 2)->AddValidator(
       [](const SubObject&, std::span<const std::uint8_t>, Origin) { return SdoAbort::kLocalControl; });
   Operational();
   master.Send("205#01D0077856");  // AO1 = 2000 > 1000

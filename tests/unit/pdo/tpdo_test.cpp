@@ -265,7 +265,7 @@ TEST_F(PdoTest, SamplingRunsReadHooks) {
   Start();
   Tpdo(1, {.entries = {0x71000110}});
   std::vector<Origin> origins;
-  od.Find(0x7100, 1)->read_hooks.push_back([&](SubObject& sub, Origin origin) {
+  od.Find(0x7100, 1)->AddReadHook([&](SubObject& sub, Origin origin) {
     origins.push_back(origin);
     sub.value = EncodeLe<std::int16_t>(0x0102);
     return SdoAbort::kNone;

@@ -27,8 +27,7 @@ inline void AddSdoTestObjects(ObjectDictionary& od, SdoAbort& veto) {
   limited.high_limit = EncodeLe<std::uint32_t>(1000);
   od.AddVar(0x2002, "Write only", DataType::kUnsigned32, Access::kWo, EncodeLe<std::uint32_t>(0));
   auto& vetoed = od.AddVar(0x2003, "Vetoed", DataType::kUnsigned16, Access::kRw, EncodeLe<std::uint16_t>(0));
-  vetoed.validators.push_back(
-      [&veto](const SubObject&, std::span<const std::uint8_t>, Origin) { return veto; });
+  vetoed.AddValidator([&veto](const SubObject&, std::span<const std::uint8_t>, Origin) { return veto; });
   od.AddVar(0x2004, "Domain", DataType::kDomain, Access::kRw, {});
   od.AddVar(0x2005, "Flag", DataType::kBoolean, Access::kRw, {0});
   od.AddVar(0x2006, "U64", DataType::kUnsigned64, Access::kRw, EncodeLe<std::uint64_t>(0));
@@ -47,7 +46,7 @@ inline void AddSdoTestObjects(ObjectDictionary& od, SdoAbort& veto) {
   record.subs.emplace(1, member);
   od.Add(record);
   auto& no_data = od.AddVar(0x2011, "No data", DataType::kUnsigned8, Access::kRo, {0});
-  no_data.read_hooks.push_back([](SubObject&, Origin) { return SdoAbort::kNoData; });
+  no_data.AddReadHook([](SubObject&, Origin) { return SdoAbort::kNoData; });
 }
 
 /// Node 5 (request 605h, response 585h) with an SDO server and a probe on the same loopback bus.

@@ -280,7 +280,7 @@ TEST_F(ParameterStoreTest, ApplyingRunsListeners) {
   BuildDictionary(od);
   ParameterStore store(od, dir_);
   std::vector<std::uint64_t> seen;
-  od.Find(0x1017, 0)->listeners.push_back(
+  od.Find(0x1017, 0)->AddListener(
       [&](SubObject& sub, Origin) { seen.push_back(DecodeUnsignedLe(sub.value)); });
   od.RestoreDefaults(0x1000, 0xFFFF, 5);
   store.ApplyStored(0x1000, 0xFFFF, 5);
