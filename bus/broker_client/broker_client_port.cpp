@@ -84,7 +84,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
     error_frame_logged_ = false;
     if (phase_ == Phase::kConnected || phase_ == Phase::kHandshake) {
       // In the handshake the Hello already left with the old rate: this follows it.
-      spdlog::info("bus {}: controller now at {}", options_.bus, RateText(bitrate));
+      const bool other = bitrate != 0 && bitrate != session_.bitrate;
+      spdlog::log(other || phase_ != Phase::kConnected ? spdlog::level::info : spdlog::level::debug,
+                  "bus {}: controller now at {}", options_.bus, RateText(bitrate));
       filling_.AddBitRate(bitrate);
       ScheduleFlush();
     } else {

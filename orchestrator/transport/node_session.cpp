@@ -294,9 +294,11 @@ void NodeSession::OnBitRate(std::uint32_t bitrate) {
   }
   broker_.SetPortBitrate(port_, bitrate);
   const std::uint32_t bus = broker_.Stats(bus_, 0).bitrate;
-  spdlog::info(
-      "{}: controller now at {} bit/s{}", label_, bitrate != 0 ? bitrate : bus,
-      bitrate != 0 && bitrate != bus ? " (the bus runs at " + std::to_string(bus) + ")" : std::string());
+  // A node stating the bus's own rate (commissioned for it) is routine; another rate is news.
+  const bool other = bitrate != 0 && bitrate != bus;
+  spdlog::log(other ? spdlog::level::info : spdlog::level::debug, "{}: controller now at {} bit/s{}", label_,
+              other ? bitrate : bus,
+              other ? " (the bus runs at " + std::to_string(bus) + ")" : std::string());
 }
 
 void NodeSession::Refuse(const std::string& reason) {
