@@ -43,6 +43,17 @@ class BusPort {
   /// The current fault-confinement state.
   virtual ControllerState State() const = 0;
 
+  /// The controller switches to `bit_per_s` (CiA 305 activate bit timing, a device's bit-rate
+  /// object at reset). True when the port follows: from now on it takes part in the bus at that
+  /// rate (the broker client tells the broker; a node at another rate than its bus's then sees
+  /// error frames and no traffic, orchestrator/broker/README.md "Bit rate"). False when the rate
+  /// is not the port's to set (SocketCAN: the interface's, `ip link set ... bitrate`; a test
+  /// loopback): the caller says so.
+  virtual bool SetBitRate(std::uint32_t bit_per_s) {
+    (void)bit_per_s;
+    return false;
+  }
+
   void OnReceive(ReceiveHandler handler) { receive_ = std::move(handler); }
   void OnStateChange(StateHandler handler) { state_change_ = std::move(handler); }
 

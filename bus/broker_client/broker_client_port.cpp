@@ -12,6 +12,7 @@
 #include <asio/write.hpp>
 #include <stdexcept>
 
+#include "bus/physics/wire_model.hpp"
 #include "bus/wire/endpoint.hpp"
 #include "bus/wire/message_writer.hpp"
 #include "bus/wire/socket_io.hpp"
@@ -76,6 +77,24 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
   }
 
   ControllerState State() const { return state_; }
+
+  void SetBitRate(std::uint32_t bitrate) {
+    if (bitrate == options_.bitrate) return;
+    options_.bitrate = bitrate;
+    error_frame_logged_ = false;
+    if (phase_ == Phase::kConnected || phase_ == Phase::kHandshake) {
+      // In the handshake the Hello already left with the old rate: this follows it.
+      const bool other = bitrate != 0 && bitrate != session_.bitrate;
+      spdlog::log(other || phase_ != Phase::kConnected ? spdlog::level::info : spdlog::level::debug,
+                  "bus {}: controller now at {}", options_.bus, RateText(bitrate));
+      filling_.AddBitRate(bitrate);
+      ScheduleFlush();
+    } else {
+      spdlog::info("bus {}: controller at {} from the next connection", options_.bus, RateText(bitrate));
+    }
+  }
+  std::uint32_t BitRate() const { return options_.bitrate; }
+
   bool Connected() const { return phase_ == Phase::kConnected; }
   std::optional<BrokerSession> Session() const {
     return Connected() ? std::optional(session_) : std::nullopt;
@@ -135,6 +154,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
     wire::Hello hello = wire::MakeHello(options_.bus, options_.node_name, options_.node_id,
                                         options_.monitor ? wire::ROLE_MONITOR : wire::ROLE_NODE);
     hello.set_tx_confirmations(options_.tx_confirmations);
+    hello.set_bitrate(options_.bitrate);
     filling_.AddHello(hello);
     const std::uint64_t gen = generation_;
     Flush();
@@ -215,6 +235,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
         stats_.rx_frames += m.frames.size();
         for (std::size_t i = 0; i < m.frames.size(); ++i) {
           const wire::StampedFrame f = m.frames[i];
+          if (f.frame.error()) OnErrorFrame(f.frame);
           owner_->Deliver(f.frame, f.time);
           if (owner_ == nullptr) return;
         }
@@ -245,9 +266,29 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       case wire::MessageType::kHello:
       case wire::MessageType::kHelloReply:
       case wire::MessageType::kNodeReply:
+      case wire::MessageType::kBitRate:
         ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from the broker");
         return;
     }
+  }
+
+  /// Counts error frames; the first one after a connection or a rate change is logged, with the
+  /// rates when they differ (the usual cause: the controller is at another rate than the bus).
+  void OnErrorFrame(const CanFrame& frame) {
+    ++stats_.rx_error_frames;
+    if (error_frame_logged_) return;
+    error_frame_logged_ = true;
+    const std::uint32_t own = options_.bitrate != 0 ? options_.bitrate : session_.bitrate;
+    if (own != session_.bitrate) {
+      spdlog::warn("bus {}: error frames (first: {}): the controller runs at {} bit/s, the bus at {} bit/s",
+                   options_.bus, ToCandump(frame), own, session_.bitrate);
+    } else {
+      spdlog::warn("bus {}: error frames (first: {})", options_.bus, ToCandump(frame));
+    }
+  }
+
+  static std::string RateText(std::uint32_t bitrate) {
+    return bitrate != 0 ? std::to_string(bitrate) + " bit/s" : std::string("the bus's bit rate");
   }
 
   void OnNodeRequest(const wire::NodeRequest& request) {
@@ -281,9 +322,12 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
     backoff_ = options_.initial_backoff;
     session_ = {reply.port_id(), reply.bitrate(), reply.mode() != wire::BUS_MODE_UNPACED};
     ++stats_.connects;
+    error_frame_logged_ = false;
+    const bool other_rate = options_.bitrate != 0 && options_.bitrate != session_.bitrate;
     const std::string detail =
         endpoint_.ToString() + " bus " + options_.bus + " (" + std::to_string(session_.bitrate) + " bit/s, " +
-        (session_.paced ? "paced" : "unpaced") + "), port " + std::to_string(session_.port_id);
+        (session_.paced ? "paced" : "unpaced") + "), port " + std::to_string(session_.port_id) +
+        (other_rate ? ", controller at " + std::to_string(options_.bitrate) + " bit/s" : std::string());
     spdlog::info("connected to broker at {}", detail);
     const std::uint64_t gen = generation_;
     if (state_ != ControllerState::kErrorActive) {
@@ -417,6 +461,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
   bool reading_ = false;  ///< delivering the messages of one read; it flushes when done
 
   ControllerState state_ = ControllerState::kErrorActive;
+  bool error_frame_logged_ = false;
   BrokerSession session_;
   BrokerClientStats stats_;
 };
@@ -436,6 +481,16 @@ bool BrokerClientPort::Send(const CanFrame& frame) {
 
 ControllerState BrokerClientPort::State() const {
   return link_->State();
+}
+
+bool BrokerClientPort::SetBitRate(std::uint32_t bit_per_s) {
+  if (bit_per_s != 0 && (bit_per_s < kMinBitrate || bit_per_s > kMaxBitrate)) return false;
+  link_->SetBitRate(bit_per_s);
+  return true;
+}
+
+std::uint32_t BrokerClientPort::BitRate() const {
+  return link_->BitRate();
 }
 
 bool BrokerClientPort::Connected() const {

@@ -26,6 +26,9 @@ struct BrokerClientOptions {
   bool monitor = false;
   /// Ask the broker for TX confirmations (OnTxConfirmed).
   bool tx_confirmations = false;
+  /// The bit rate the controller runs at (bit/s, Hello.bitrate); 0 = not stated: the broker runs
+  /// the port at its bus's rate. SetBitRate changes it.
+  std::uint32_t bitrate = 0;
   /// Reconnection delays: the first retry after `initial_backoff`, doubling up to `max_backoff`;
   /// back to `initial_backoff` after a successful Hello.
   std::chrono::milliseconds initial_backoff{100};
@@ -47,13 +50,14 @@ struct BrokerClientStats {
   std::uint64_t connects = 0;     ///< accepted Hellos
   std::uint64_t disconnects = 0;  ///< established connections lost
   std::uint64_t failed_attempts = 0;
-  std::uint64_t tx_frames = 0;       ///< frames accepted by Send
-  std::uint64_t tx_refused = 0;      ///< Send returned false
-  std::uint64_t rx_frames = 0;       ///< frames delivered to OnReceive
-  std::uint64_t writes = 0;          ///< socket writes (one per io_context turn at most)
-  std::uint64_t partial_writes = 0;  ///< of those, taken only in part by the socket
-  std::uint64_t reads = 0;           ///< socket reads
-  std::uint64_t empty_reads = 0;     ///< of those, found nothing to read (EAGAIN)
+  std::uint64_t tx_frames = 0;        ///< frames accepted by Send
+  std::uint64_t tx_refused = 0;       ///< Send returned false
+  std::uint64_t rx_frames = 0;        ///< frames delivered to OnReceive
+  std::uint64_t rx_error_frames = 0;  ///< of those, error frames (CanFrame::kError)
+  std::uint64_t writes = 0;           ///< socket writes (one per io_context turn at most)
+  std::uint64_t partial_writes = 0;   ///< of those, taken only in part by the socket
+  std::uint64_t reads = 0;            ///< socket reads
+  std::uint64_t empty_reads = 0;      ///< of those, found nothing to read (EAGAIN)
 };
 
 /// A BusPort on a broker's virtual bus, over TCP or a Unix-domain socket, driven by an
@@ -64,7 +68,9 @@ struct BrokerClientStats {
 /// - Send appends the frame to an outgoing batch; the batch is written once per io_context turn,
 ///   so a burst of frames is one write. Buffers are reused: no allocation per frame.
 /// - Received frames reach OnReceive with their bus time; controller events reach OnStateChange
-///   and State().
+///   and State(). Error frames (a node at another bit rate than its bus's sees them, README of
+///   orchestrator/broker) reach OnReceive too, flagged CanFrame::kError; the first one after a
+///   connection or a rate change is logged.
 /// - When the broker goes away (or refuses the Hello), the port logs why and reconnects with
 ///   exponential backoff ("broker connection lost: ...; reconnecting in 400 ms"). While it is
 ///   disconnected Send returns false: the frames are lost, as on an unplugged cable. Each new
@@ -92,6 +98,12 @@ class BrokerClientPort final : public BusPort {
   /// transmit queue is full.
   bool Send(const CanFrame& frame) override;
   ControllerState State() const override;
+  /// Sends BitRate to the broker now if connected (else the next Hello states it). False (and
+  /// nothing changes) outside 10 000..1 000 000 bit/s.
+  /// `bit_per_s` 0 returns the port to its bus's rate. Logs the change.
+  bool SetBitRate(std::uint32_t bit_per_s) override;
+  /// The rate stated to the broker (0 = none: the bus's rate).
+  std::uint32_t BitRate() const;
 
   bool Connected() const;
   /// The current connection's parameters; nullopt while disconnected.

@@ -63,6 +63,16 @@ inline constexpr std::uint32_t kAckErrorTailBits = 1 + 1 + 6 + 8 + 3;
 /// flags (up to 12 bits when nodes detect the error at different bits) are not modelled.
 inline constexpr std::uint32_t kCrcErrorTailBits = 1 + 1 + 1 + 6 + 8 + 3;
 
+/// A transfer that no controller at the transmitter's bit rate acknowledges while controllers at
+/// another rate are on the bus: to them the frame is noise, and the first violation of the bit
+/// stuffing rule they sample (six equal bits, ISO 11898-1:2015 §10.5 bit stuffing, §10.9.3 stuff
+/// error) makes them send an error flag, which the transmitter sees as a bit error (§10.9.2). The
+/// broker's model of it, in bit times of the transmitter's rate: start of frame 1, six bits to the
+/// stuff error, error flag 6, error delimiter 8, intermission 3. Where exactly a controller at
+/// another rate detects its first error depends on both rates and on the frame; six bits is the
+/// earliest a stuff error can occur, and the attempt is short whatever the frame.
+inline constexpr std::uint32_t kRateErrorAttemptBits = 1 + 6 + 6 + 8 + 3;
+
 /// After transmitting a frame, an error-passive node sends 8 recessive bits (suspend transmission)
 /// following the intermission before it may start another transfer; other nodes may start in the
 /// meantime (ISO 11898-1:2015 §10.4, interframe space: suspend transmission; §6.14 error-passive).
@@ -73,6 +83,9 @@ enum class TransferOutcome : std::uint8_t {
   kOk,        ///< acknowledged, valid for everyone
   kAckError,  ///< nobody acknowledged (the transmitter is alone on the bus)
   kCrcError,  ///< destroyed by an error frame (fault injection)
+  /// Destroyed by the error flags of controllers at another bit rate; nobody at the transmitter's
+  /// rate acknowledged it (kRateErrorAttemptBits).
+  kRateError,
 };
 
 /// Bus occupancy of one transfer attempt of `frame`, including the intermission that follows it.
@@ -83,6 +96,8 @@ inline std::uint32_t AttemptBits(const CanFrame& frame, TransferOutcome outcome)
       return bits.unstuffed + bits.stuff + kAckErrorTailBits;
     case TransferOutcome::kCrcError:
       return bits.unstuffed + bits.stuff + kCrcErrorTailBits;
+    case TransferOutcome::kRateError:
+      return kRateErrorAttemptBits;
     case TransferOutcome::kOk:
       break;
   }

@@ -129,6 +129,10 @@ void MessageWriter::AddNodeReply(const NodeReply& reply) {
   AppendProto([&](Envelope& e) { *e.mutable_node_reply() = reply; });
 }
 
+void MessageWriter::AddBitRate(std::uint32_t bitrate) {
+  AppendProto([&](Envelope& e) { e.mutable_bit_rate()->set_bitrate(bitrate); });
+}
+
 void MessageWriter::Clear() {
   buffer_.clear();
   batch_open_ = false;

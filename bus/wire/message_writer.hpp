@@ -88,6 +88,8 @@ class MessageWriter {
   void AddError(std::string_view reason);
   void AddNodeRequest(const NodeRequest& request);
   void AddNodeReply(const NodeReply& reply);
+  /// BitRate{bitrate}: the node's controller now runs at `bitrate` bit/s (0: the bus's rate).
+  void AddBitRate(std::uint32_t bitrate);
   /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write
   /// that went to the socket only in part), after closing the open batch.
   void AddEncoded(const std::uint8_t* bytes, std::size_t size);

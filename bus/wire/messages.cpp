@@ -26,6 +26,8 @@ const char* ToString(MessageType type) {
       return "NodeRequest";
     case MessageType::kNodeReply:
       return "NodeReply";
+    case MessageType::kBitRate:
+      return "BitRate";
   }
   return "unknown";
 }

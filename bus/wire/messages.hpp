@@ -21,7 +21,8 @@ namespace canfleet::wire {
 /// Bumped on any incompatible change of canfleet_wire.proto or of the record layout. A Hello with
 /// another version is refused with a reason naming both.
 /// 2: NodeRequest / NodeReply.
-inline constexpr std::uint32_t kProtocolVersion = 2;
+/// 3: Hello.bitrate and BitRate (the node's controller bit rate).
+inline constexpr std::uint32_t kProtocolVersion = 3;
 
 /// Largest Envelope (without its length prefix). Longer = protocol error.
 inline constexpr std::size_t kMaxMessageSize = std::size_t{1} << 20;
@@ -44,6 +45,7 @@ enum class MessageType : std::uint8_t {
   kError,        ///< the peer is about to close; envelope.error().reason() says why
   kNodeRequest,  ///< broker -> node: envelope.node_request()
   kNodeReply,    ///< node -> broker: envelope.node_reply()
+  kBitRate,      ///< node -> broker: envelope.bit_rate()
 };
 
 const char* ToString(MessageType type);
@@ -56,7 +58,7 @@ struct Message {
   FrameRecords frames;
   /// kControllerEvent, converted and range-checked.
   canfleet::ControllerEvent controller;
-  /// kHello, kHelloReply, kPing, kPong, kError, kNodeRequest, kNodeReply: the parsed Envelope
+  /// kHello, kHelloReply, kPing, kPong, kError, kNodeRequest, kNodeReply, kBitRate: the parsed Envelope
   /// (envelope.hello(), ...).
   Envelope envelope;
 };

@@ -223,6 +223,9 @@ bool StreamDecoder::DecodeEnvelope(std::span<const std::uint8_t> body, Message& 
     case Envelope::kNodeReply:
       out.type = MessageType::kNodeReply;
       return true;
+    case Envelope::kBitRate:
+      out.type = MessageType::kBitRate;
+      return true;
     case Envelope::BODY_NOT_SET:
       break;
   }

@@ -1,8 +1,10 @@
 #include "node/devices/device_node.hpp"
 
+#include <memory>
 #include <stdexcept>
-
 #include <string>
+
+#include "node/canopen/lss/lss_protocol.hpp"
 #include "node/canopen/storage/parameter_store.hpp"
 
 namespace canfleet::devices {
@@ -27,6 +29,19 @@ void ApplySerialNumber(canopen::ObjectDictionary& od, std::uint32_t serial) {
   sub->default_value = canopen::EncodeLe(serial, canopen::FixedSize(sub->type).value_or(4));
   sub->default_adds_node_id = false;
   sub->value = sub->default_value;
+}
+
+/// Port `p`'s bit timing changes (LSS activate bit timing, the bit-rate object at reset): the bus
+/// port follows (BusPort::SetBitRate), and `*report` (if set) is told whether it did.
+canopen::StackHooks BitRateHooks(std::size_t p, BusPort& port, const DeviceNode::BitRateReport* report) {
+  canopen::StackHooks hooks;
+  hooks.on_bit_timing = [p, &port, report](std::uint8_t index) {
+    const auto kbit = canopen::BitRateKbit(index);
+    if (!kbit) return;
+    const bool applied = port.SetBitRate(*kbit * 1000);
+    if (*report) (*report)(p, *kbit, applied);
+  };
+  return hooks;
 }
 
 }  // namespace
@@ -69,7 +84,8 @@ DeviceNode::DeviceNode(std::unique_ptr<Device> device, Scheduler& scheduler, std
       setup.options.state_dir =
           count == 1 ? settings.state_dir : settings.state_dir / ("port" + std::to_string(p + 1));
     device_->ConfigureStack(p, setup);
-    setup.hooks = ChainHooks(std::move(setup.hooks), settings.hooks);
+    setup.hooks = ChainHooks(ChainHooks(std::move(setup.hooks), settings.hooks),
+                             BitRateHooks(p, *ports[p], &on_bit_rate_));
     stacks_.push_back(std::make_unique<canopen::CanopenStack>(
         *dictionaries_[p], *device_ports_[p], scheduler, std::move(setup.options), std::move(setup.hooks),
         std::move(setup.policy)));

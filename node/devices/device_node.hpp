@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -57,6 +58,13 @@ class DeviceNode {
   /// Power-on of every stack, port order: parameters restored, reset application, boot-up.
   void Start();
 
+  /// Port `port` (0-based) switched its bit rate to `kbit` (LSS activate bit timing, the device's
+  /// bit-rate object at reset): `applied` says whether the bus port followed (BusPort::SetBitRate;
+  /// false on SocketCAN, whose rate is the interface's).
+  using BitRateReport = std::function<void(std::size_t port, std::uint32_t kbit, bool applied)>;
+  /// Tells `report` of every switch from now on.
+  void OnBitRate(BitRateReport report) { on_bit_rate_ = std::move(report); }
+
   Device& device() { return *device_; }
   SimulatedIo& io() { return device_->io(); }
   std::size_t PortCount() const { return stacks_.size(); }
@@ -73,6 +81,7 @@ class DeviceNode {
   std::vector<std::unique_ptr<canopen::ObjectDictionary>> dictionaries_;
   std::vector<std::unique_ptr<canopen::CanopenStack>> stacks_;
   std::unique_ptr<Device> device_;
+  BitRateReport on_bit_rate_;
 };
 
 /// Runs `first` then `second` for every hook either sets.

@@ -26,6 +26,7 @@ class DevicePort final : public BusPort {
   /// The stack's transmissions: dropped while muted (returns false, as a controller that is off).
   bool Send(const CanFrame& frame) override;
   ControllerState State() const override { return port_.State(); }
+  bool SetBitRate(std::uint32_t bit_per_s) override { return port_.SetBitRate(bit_per_s); }
 
   /// A frame the device sends itself (not muted: the device decides when it speaks).
   bool SendFromDevice(const CanFrame& frame) { return port_.Send(frame); }

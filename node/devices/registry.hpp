@@ -25,8 +25,10 @@ struct DeviceInfo {
   std::string_view name;     ///< the --device value
   std::string_view summary;  ///< one line for --list-devices
   std::size_t ports = 1;     ///< CAN ports of the product (the data logger has 2)
-  /// The node-ID and bit rate the product leaves the factory with (its manual), used when a
-  /// topology or the command line names none.
+  /// The node-ID and bit rate the product leaves the factory with (its manual). The node-ID is used
+  /// when a topology or the command line names none; the bit rate is the stack's until the node is
+  /// commissioned for the bus it is plugged into (node/process/bit_rate_commissioning.hpp), unless
+  /// LSS stored another.
   std::uint8_t factory_node_id = 127;
   std::uint32_t factory_bit_rate_kbit = 125;
   std::string_view eds_file_name;         ///< "quad-controller.eds", for messages and --write-eds

@@ -13,9 +13,11 @@
 #include "bus/broker_client/broker_client_port.hpp"
 #include "bus/socketcan/socketcan_port.hpp"
 #include "clock/asio_scheduler.hpp"
+#include "node/canopen/lss/lss_protocol.hpp"
 #include "node/canopen/storage/atomic_file.hpp"
 #include "node/devices/device_node.hpp"
 #include "node/devices/registry.hpp"
+#include "node/process/bit_rate_commissioning.hpp"
 #include "node/process/node_options.hpp"
 #include "node/process/node_telemetry_wiring.hpp"
 #include "node/process/release_memory.hpp"
@@ -93,20 +95,38 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   settings.hooks.on_storage_issue = [log](const std::string& text) {
     log->warn("stored parameters: {}", text);
   };
+  devices::DeviceNode::BitRateReport on_bit_rate = [log, told = std::vector<bool>(port_count, false)](
+                                                       std::size_t p, std::uint32_t kbit,
+                                                       bool applied) mutable {
+    if (applied) {
+      log->info("port {}: bit rate now {} kbit/s", p + 1, kbit);
+    } else if (!told[p]) {
+      told[p] = true;  // once: the interface's rate does not change with the node's settings
+      log->warn(
+          "port {}: bit rate {} kbit/s not applied: a SocketCAN interface runs at the rate it was "
+          "given (ip link set IFACE type can bitrate ...)",
+          p + 1, kbit);
+    }
+  };
   auto telemetry = node::StartNodeTelemetry(telemetry_settings, settings, *log);  // DDS (issue 7)
 
   std::unique_ptr<devices::DeviceNode> node;
   std::size_t connected_ports = 0;
+  std::vector<std::unique_ptr<BusPort>> ports;
   auto start_when_all_connected = [&] {
     if (++connected_ports == port_count) {
+      for (std::size_t p = 0; p < port_count; ++p)
+        node::CommissionBitRate(*node, p, *ports[p],
+                                [&log](const std::string& line) { log->info("{}", line); });
       node->Start();
       log->info("powered on");
       node::ReleaseFreedHeap();  // what loading the stored parameters freed
     }
   };
-  std::vector<std::unique_ptr<BusPort>> ports;
   std::vector<BusPort*> raw_ports;
-  // A variant left unconfigured boots as it leaves the factory (its manual's node-ID and bit rate).
+  // A variant left unconfigured boots as it leaves the factory (its manual's node-ID and bit rate);
+  // at the first connection a port whose rate nobody configured is commissioned for its bus
+  // (node/process/bit_rate_commissioning.hpp).
   const devices::DeviceInfo* variant = devices::FindDevice(options.device);
   const std::uint8_t bit_timing =
       variant ? devices::BitTimingIndexOf(variant->factory_bit_rate_kbit).value_or(4) : std::uint8_t{4};
@@ -117,6 +137,18 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     raw_ports.push_back(ports.back().get());
   }
   node = std::make_unique<devices::DeviceNode>(std::move(device), scheduler, raw_ports, settings);
+  node->OnBitRate(std::move(on_bit_rate));
+  // A bit rate stored by LSS (CiA 305 store configuration) is the controller's from power-on: the
+  // Hello states it. SocketCAN runs at its interface's rate, whatever the node's settings say.
+  for (std::size_t p = 0; p < port_count; ++p) {
+    if (options.buses[p].socketcan) {
+      log->info("port {}: bit rate: the SocketCAN interface's ({} is not applied to it)", p + 1,
+                "LSS activate bit timing or a bit-rate object");
+    } else if (node->stack(p).BitTimingStored()) {
+      if (auto kbit = canopen::BitRateKbit(node->stack(p).BitTimingIndex()))
+        ports[p]->SetBitRate(*kbit * 1000);
+    }
+  }
   if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options));
   // Remote I/O: the orchestrator sets and reads the simulated I/O over the broker connection.
   for (auto& port : ports)

@@ -58,6 +58,12 @@ bool Broker::RecoverBusOff(PortId id) {
   return ref->bus->RecoverBusOff(*ref->port);
 }
 
+bool Broker::SetPortBitrate(PortId id, std::uint32_t bitrate) {
+  const PortRef* ref = FindPort(id);
+  if (ref == nullptr) return false;
+  return ref->bus->SetBitrate(*ref->port, bitrate);
+}
+
 FaultStage& Broker::Faults(std::string_view bus) {
   return FindBus(bus).Faults();
 }

@@ -56,7 +56,7 @@ class Broker {
   void AddBus(const BusConfig& config);
 
   /// Attaches a port to `bus`. `sink` must stay valid until Detach. Throws std::invalid_argument
-  /// on an unknown bus.
+  /// on an unknown bus or an AttachOptions::bitrate outside 10 000..1 000 000 (0 = the bus's).
   PortId Attach(std::string_view bus, std::string port_name, PortSink& sink, AttachOptions options = {});
 
   /// Detaches a port: its queue is discarded and its sink is never called again (also when called
@@ -76,6 +76,13 @@ class Broker {
   /// FaultStage::HoldErrorPassive holds it). Ends a FaultStage::ForceBusOff hold. False when it is
   /// not bus-off or unknown, and while FaultStage::HoldBusOff holds it (the attempt fails).
   bool RecoverBusOff(PortId port);
+
+  /// The port's controller now runs at `bitrate` bit/s (0 = its bus's rate), as after CiA 305
+  /// "activate bit timing": from now on it exchanges frames only with the ports at that rate and
+  /// sees the others' as error frames (README "Bit rate"). Its counters, state and queue stay. False
+  /// for an unknown or detached port; throws std::invalid_argument on a rate outside
+  /// 10 000..1 000 000.
+  bool SetPortBitrate(PortId port, std::uint32_t bitrate);
 
   /// The fault stage of a bus. Throws std::invalid_argument on an unknown bus.
   FaultStage& Faults(std::string_view bus);

@@ -36,6 +36,10 @@ struct AttachOptions {
   /// frame's identifier and format flag, DLC 0, at the end of the error frame. Off for nodes: a
   /// CANopen stack has no use for them; captures want them.
   bool error_frames = false;
+  /// The bit rate the port's controller runs at, bit/s (10 000..1 000 000); 0 = the bus's rate.
+  /// A port at another rate than the transmitter of a frame does not receive it: it sees an error
+  /// frame and counts a receive error (README "Bit rate").
+  std::uint32_t bitrate = 0;
 };
 
 }  // namespace canfleet::broker

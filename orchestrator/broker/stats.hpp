@@ -50,12 +50,16 @@ struct PortStats {
   std::string bus;
   std::string name;
   ControllerEvent controller;  ///< state, TEC, REC now
-  std::size_t queued = 0;      ///< frames waiting in the TX queue (including one being retried)
+  /// The bit rate the port's controller runs at (bit/s): the bus's unless the port stated another
+  /// (AttachOptions::bitrate, Broker::SetPortBitrate).
+  std::uint32_t bitrate = 0;
+  std::size_t queued = 0;  ///< frames waiting in the TX queue (including one being retried)
 
-  std::uint64_t tx_frames = 0;      ///< own frames acknowledged on the wire
-  std::uint64_t rx_frames = 0;      ///< frames delivered to this port
-  std::uint64_t tx_errors = 0;      ///< failed transmit attempts (ACK errors, corrupted frames)
-  std::uint64_t rx_errors = 0;      ///< receive errors (corrupted frames seen as a receiver)
+  std::uint64_t tx_frames = 0;  ///< own frames acknowledged on the wire
+  std::uint64_t rx_frames = 0;  ///< frames delivered to this port
+  std::uint64_t tx_errors = 0;  ///< failed transmit attempts (ACK errors, corrupted frames)
+  /// Receive errors: corrupted frames seen as a receiver, and transfers at another bit rate.
+  std::uint64_t rx_errors = 0;
   std::uint64_t queue_drops = 0;    ///< submitted while the TX queue was full
   std::uint64_t invalid_drops = 0;  ///< invalid frames, error frames, or sent by a listen-only port
   std::uint64_t bus_off_drops = 0;  ///< submitted while bus-off, or flushed from the queue at bus-off

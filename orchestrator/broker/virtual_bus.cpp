@@ -41,6 +41,21 @@ std::uint64_t NextRoundId() {
   return next.fetch_add(1, std::memory_order_relaxed);
 }
 
+void CheckBitrate(const BusConfig& config, std::uint32_t bitrate) {
+  if (bitrate != 0 && (bitrate < kMinBitrate || bitrate > kMaxBitrate))
+    throw std::invalid_argument("bus " + config.name + ": port bit rate " + std::to_string(bitrate) +
+                                " outside 10000..1000000 bit/s");
+}
+
+/// What a receiver sees of a failed transfer or of a frame at another bit rate: the frame's
+/// identifier and format with kError set, DLC 0 (AttachOptions::error_frames).
+CanFrame ErrorFrameOf(const CanFrame& frame) {
+  CanFrame error_frame;
+  error_frame.id = frame.id;
+  error_frame.flags = static_cast<std::uint8_t>(CanFrame::kError | (frame.flags & CanFrame::kExtended));
+  return error_frame;
+}
+
 /// What the wire carries: bytes beyond the DLC are not part of a frame (and a remote frame has
 /// none), so they are cleared and captures of the same traffic are byte-identical.
 CanFrame Normalized(const CanFrame& in) {
@@ -85,7 +100,9 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
 // Ports
 
 Port& VirtualBus::Attach(PortId id, std::string name, PortSink& sink, AttachOptions options) {
+  CheckBitrate(config_, options.bitrate);
   auto port = std::make_unique<Port>(id, std::move(name), sink, options, Now(), config_.tx_queue_capacity);
+  port->bitrate = options.bitrate != 0 ? options.bitrate : config_.bitrate;
   port->round_begin = static_cast<std::uint32_t>(round_.frames_.size());  // nothing from before it attached
   port->exceptions.reserve(64);
   port->tx.reserve(64);
@@ -231,6 +248,21 @@ bool VirtualBus::StopBabbling(Port& port) {
   });
 }
 
+bool VirtualBus::SetBitrate(Port& port, std::uint32_t bitrate) {
+  CheckBitrate(config_, bitrate);
+  return WithRound([&] {
+    if (port.detached) return false;
+    // A transfer of the port already on the wire ends as it began; from now on the port takes
+    // part at its new rate (the switch of CiA 305 §8.3.2 happens between frames).
+    port.bitrate = bitrate != 0 ? bitrate : config_.bitrate;
+    Disturb();
+    // Who acknowledges whom changed: unpaced ports waiting after an ACK error may try again.
+    for (auto& p : ports_)
+      p->ack_blocked = false;
+    return true;
+  });
+}
+
 Port& VirtualBus::PortOnBus(PortId id) const {
   Port* port = Find(id);
   if (port == nullptr)
@@ -343,19 +375,24 @@ Port* VirtualBus::Arbitrate(BusTime start) const {
   return winner;
 }
 
-bool VirtualBus::HasAcknowledger(const Port& transmitter, BusTime start) const {
+TransferOutcome VirtualBus::AckOutcome(const Port& transmitter, BusTime start) const {
+  // Only a controller at the transmitter's rate samples the frame as sent and acknowledges it. To
+  // one at another rate it is noise: it signals an error (README "Bit rate"), and when nobody
+  // acknowledges, those error flags are what the transmitter sees (a bit error, not an ACK error).
+  bool other_rate = false;
   for (const auto& p : ports_) {
     if (p.get() == &transmitter || p->detached || !AttachedBy(*p, start)) continue;
-    if (Acknowledges(p->controller.State(), p->options.listen_only)) return true;
+    if (!Acknowledges(p->controller.State(), p->options.listen_only)) continue;
+    if (p->bitrate == transmitter.bitrate) return TransferOutcome::kOk;
+    other_rate = true;
   }
-  return false;
+  return other_rate ? TransferOutcome::kRateError : TransferOutcome::kAckError;
 }
 
 TransferOutcome VirtualBus::Outcome(Port& transmitter, const CanFrame& frame, BusTime start) {
   if (!rules_.Empty() && rules_.CorruptAttempt(transmitter.id, frame, start))
     return TransferOutcome::kCrcError;
-  if (!HasAcknowledger(transmitter, start)) return TransferOutcome::kAckError;
-  return TransferOutcome::kOk;
+  return AckOutcome(transmitter, start);
 }
 
 void VirtualBus::Process(BusTime now, bool start_at_now) {
@@ -415,7 +452,8 @@ void VirtualBus::Process(BusTime now, bool start_at_now) {
           Port* winner = Arbitrate(*start);
           const QueuedFrame& head = Head(*winner);
           const TransferOutcome outcome = Outcome(*winner, head.frame, *start);
-          const BusTime end = *start + BitTime(AttemptBits(head.frame, outcome), config_.bitrate);
+          // The transmitter's bit rate sets the length (the bus's, unless the port runs at another).
+          const BusTime end = *start + BitTime(AttemptBits(head.frame, outcome), winner->bitrate);
           in_flight_ = InFlight{winner, head, winner->queue_epoch, *start, end, outcome};
         } else {
           // No time line: the oldest submission goes, taking no time.
@@ -476,6 +514,10 @@ std::uint64_t VirtualBus::DeliverToEach(const InFlight& transfer, std::uint32_t 
       rx.exceptions.push_back(index);
       continue;
     }
+    if (rx.bitrate != tx.bitrate) {
+      SeeAtAnotherRate(rx, transfer, index);
+      continue;
+    }
     const FaultRules::Decision decision = faults ? rules_.ForReceiver(rx.id) : FaultRules::Decision{};
     switch (decision.kind) {
       case FaultRules::Decision::kDeliver:
@@ -523,20 +565,32 @@ void VirtualBus::Confirm(const InFlight& transfer, const TimedFrame& timed, bool
   SuspendIfPassive(tx, transfer.end);
 }
 
+void VirtualBus::SeeAtAnotherRate(Port& rx, const InFlight& transfer, std::uint32_t index) {
+  rx.exceptions.push_back(index);
+  AddPrivateFrame(rx, {ErrorFrameOf(transfer.entry.frame), transfer.end});
+  if (rx.options.listen_only) return;  // a monitor counts nothing
+  ++rx.rx_errors;
+  Emit(rx, rx.controller.OnReceiveError());
+  Disturb();  // REC changed
+}
+
 void VirtualBus::Failed(const InFlight& transfer) {
   ++error_frames_;
   Disturb();  // counters change below
-  CanFrame error_frame;
-  error_frame.id = transfer.entry.frame.id;
-  error_frame.flags =
-      static_cast<std::uint8_t>(CanFrame::kError | (transfer.entry.frame.flags & CanFrame::kExtended));
+  const Port& tx = *transfer.port;
+  const CanFrame error_frame = ErrorFrameOf(transfer.entry.frame);
+  // Error frames go to the ports that asked for them, and to every port when the transfer failed
+  // for a bit rate (the error flags of the ports at another rate) or was sent at another rate than
+  // the port's own: those are what a node at the wrong rate, or its neighbours, see.
+  const bool rate_error = transfer.outcome == TransferOutcome::kRateError;
   for (std::size_t i = 0; i < ports_.size(); ++i) {
     Port& p = *ports_[i];
-    if (p.options.error_frames && Receives(p, transfer.start))
+    if (&p == &tx || !Receives(p, transfer.start)) continue;
+    if (p.options.error_frames || rate_error || p.bitrate != tx.bitrate)
       AddPrivateFrame(p, {error_frame, transfer.end});
   }
   if (TransmitterLive(transfer)) CountTransmitError(transfer);
-  if (transfer.outcome == TransferOutcome::kCrcError) CountReceiveErrors(transfer);
+  if (transfer.outcome != TransferOutcome::kAckError) CountReceiveErrors(transfer);
 }
 
 void VirtualBus::CountTransmitError(const InFlight& transfer) {
@@ -575,7 +629,7 @@ void VirtualBus::AttemptRecovery(Port& port) {
     // The cause persists: the controller does not see its 128 × 11 recessive bits, stays bus-off
     // and starts counting again.
     ++port.failed_recoveries;
-    port.recover_at = RecoveryAttemptAt(*port.recover_at, config_.bitrate);
+    port.recover_at = RecoveryAttemptAt(*port.recover_at, port.bitrate);
     return;
   }
   Recover(port);
@@ -603,14 +657,14 @@ void VirtualBus::EnterBusOff(Port& port, BusTime at) {
   ++port.queue_epoch;
   port.ready_at = BusTime{};
   if (config_.auto_recover && !port.hold_bus_off && !port.recover_at) {
-    port.recover_at = RecoveryAttemptAt(at, config_.bitrate);
+    port.recover_at = RecoveryAttemptAt(at, port.bitrate);
     ++pending_recoveries_;
   }
 }
 
 void VirtualBus::SuspendIfPassive(Port& port, BusTime end) {
   if (config_.paced && port.controller.State() == ControllerState::kErrorPassive)
-    port.ready_at = ReadyAfterTransfer(ControllerState::kErrorPassive, end, config_.bitrate);
+    port.ready_at = ReadyAfterTransfer(ControllerState::kErrorPassive, end, port.bitrate);
 }
 
 void VirtualBus::Emit(Port& port, const std::optional<ControllerEvent>& event) {
@@ -625,6 +679,7 @@ bool VirtualBus::ReceiversAtRest(const Port& tx, BusTime start) {
     for (const auto& p : ports_) {
       rest_.newest_attach = std::max(rest_.newest_attach, p->attached_at);
       const bool at_rest = !p->detached && p->controller.State() != ControllerState::kBusOff &&
+                           p->bitrate == config_.bitrate &&
                            (p->options.listen_only || p->controller.ReceiveSuccessChangesNothing());
       if (!at_rest) {
         ++rest_.busy;
@@ -800,6 +855,7 @@ PortStats VirtualBus::StatsOf(const Port& port) const {
   s.bus = config_.name;
   s.name = port.name;
   s.controller = port.controller.Snapshot();
+  s.bitrate = port.bitrate;
   s.queued = port.queue.size();
   s.tx_frames = port.tx_frames;
   s.rx_frames = port.rx_frames;

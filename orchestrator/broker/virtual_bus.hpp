@@ -46,6 +46,9 @@ struct Port {
   std::string name;
   PortSink* sink;  ///< nullptr once detached
   AttachOptions options;
+  /// The rate its controller runs at (bit/s): AttachOptions::bitrate, or the bus's. A transfer
+  /// reaches only the ports at its transmitter's rate (VirtualBus::SetBitrate).
+  std::uint32_t bitrate = 0;
   BusTime attached_at;  ///< transfers that started before this are not received
   bool detached = false;
 
@@ -102,6 +105,9 @@ class VirtualBus {
   bool HoldErrorPassive(Port& port, bool on);
   bool StartBabbling(Port& port, const CanFrame& frame);
   bool StopBabbling(Port& port);
+  /// The port's controller now runs at `bitrate` (0 = the bus's rate). Throws
+  /// std::invalid_argument outside 10 000..1 000 000.
+  bool SetBitrate(Port& port, std::uint32_t bitrate);
   /// The attached port `id`; throws std::invalid_argument when it is not on this bus.
   Port& PortOnBus(PortId id) const;
 
@@ -161,7 +167,10 @@ class VirtualBus {
   bool AttachedBy(const Port& port, BusTime start) const {
     return !config_.paced || port.attached_at <= start;
   }
-  bool HasAcknowledger(const Port& transmitter, BusTime start) const;
+  /// How a transfer of `transmitter` that started at `start` ends if no fault rule corrupts it:
+  /// acknowledged by a port at its rate (kOk); else destroyed by the error flags of a port at
+  /// another rate (kRateError); else nobody drives the bus but the transmitter (kAckError).
+  TransferOutcome AckOutcome(const Port& transmitter, BusTime start) const;
   /// Whether `port` takes part in a transfer that started at `start` as a receiver.
   bool Receives(const Port& port, BusTime start) const {
     return !port.detached && AttachedBy(port, start) && port.controller.State() != ControllerState::kBusOff;
@@ -188,6 +197,10 @@ class VirtualBus {
   /// Failed (ACK or CRC error): error frames to the ports that want them, the counters' rules.
   void Failed(const InFlight& transfer);
   void CountTransmitError(const InFlight& transfer);
+  /// A receiver at another rate than the transmitter: instead of the frame it sees an error frame
+  /// and counts a receive error (ISO 11898-1:2015 §12.1.4.2 rule 1). `index`: the frame's place in
+  /// the shared round, which `rx` skips.
+  void SeeAtAnotherRate(Port& rx, const InFlight& transfer, std::uint32_t index);
   void CountReceiveErrors(const InFlight& transfer);
 
   void DeliverDelayed(const Delayed& delayed);
@@ -216,7 +229,8 @@ class VirtualBus {
   /// Ends the round's sharing: every port has been flushed.
   void ResetRound();
   /// Whether a frame sent by `tx` that started at `start` needs no work per receiver: no port
-  /// other than `tx` is detached, bus-off, counting REC down or (paced) attached after `start`.
+  /// other than `tx` is detached, bus-off, counting REC down, at another bit rate than the bus or
+  /// (paced) attached after `start`.
   /// Then every other port receives it and nothing else changes (the fast path of Delivered).
   bool ReceiversAtRest(const Port& tx, BusTime start);
   /// Something ReceiversAtRest depends on may have changed.

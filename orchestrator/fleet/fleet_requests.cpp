@@ -136,6 +136,7 @@ control::Status Fleet::Status() const {
   status.set_topology(options_.topology.name());
   status.set_uptime_s(Uptime());
   std::map<std::pair<std::string, std::string>, broker::PortStats> ports;  // (bus, name)
+  std::map<std::string, std::uint32_t> bus_rates;
   for (const auto& bus : broker_.Buses()) {
     const auto stats = broker_.Stats(bus, 0);
     auto* out = status.add_buses();
@@ -148,6 +149,7 @@ control::Status Fleet::Status() const {
     out->set_error_frames_per_s(stats.error_frames_per_s);
     out->set_frames(stats.frames);
     out->set_error_frames(stats.error_frames);
+    bus_rates[bus] = stats.bitrate;
     for (auto& port : broker_.Ports(bus))
       ports[{bus, port.name}] = port;  // the newest attachment of a name wins
   }
@@ -186,6 +188,7 @@ control::Status Fleet::Status() const {
                                                                          : "error-active");
         port->set_tec(c.tec);
         port->set_rec(c.rec);
+        if (it->second.bitrate != bus_rates[bus]) port->set_bitrate(it->second.bitrate);
       }
       const NodeLiveState* live = tracker_.Find(bus, node.node_ids[p]);
       port->set_booted(live && live->booted);

@@ -5,6 +5,7 @@
 #include <asio/write.hpp>
 #include <stdexcept>
 
+#include "bus/physics/wire_model.hpp"
 #include "bus/wire/frame_record.hpp"
 #include "bus/wire/socket_io.hpp"
 #include "orchestrator/transport/round_encoding.hpp"
@@ -21,6 +22,17 @@ asio::const_buffer Buffer(std::span<const std::uint8_t> s) {
 
 wire::StampedFrame Stamped(const broker::TimedFrame& f) {
   return {f.frame, f.time};
+}
+
+/// 0 (the bus's rate) or a rate the broker accepts (bus/physics/wire_model.hpp).
+bool ValidBitrate(std::uint32_t bitrate) {
+  return bitrate == 0 || (bitrate >= kMinBitrate && bitrate <= kMaxBitrate);
+}
+
+/// ", at 250000 bit/s on a 500000 bit/s bus" when a node states another rate than its bus's.
+std::string RateNote(std::uint32_t bitrate, std::uint32_t bus) {
+  if (bitrate == 0 || bitrate == bus) return {};
+  return ", at " + std::to_string(bitrate) + " bit/s on a " + std::to_string(bus) + " bit/s bus";
 }
 
 std::string JoinBuses(const std::vector<std::string>& names) {
@@ -149,6 +161,9 @@ void NodeSession::Handle(const wire::Message& m) {
     case MessageType::kNodeReply:
       OnNodeReply(m.envelope.node_reply());
       return;
+    case MessageType::kBitRate:
+      OnBitRate(m.envelope.bit_rate().bitrate());
+      return;
     case MessageType::kHelloReply:
     case MessageType::kTxConfirm:
     case MessageType::kControllerEvent:
@@ -225,7 +240,12 @@ void NodeSession::OnHello(const wire::Hello& hello) {
     Refuse("node_id " + std::to_string(hello.node_id()) + " outside 0..127");
     return;
   }
+  if (!ValidBitrate(hello.bitrate())) {
+    Refuse("bit rate " + std::to_string(hello.bitrate()) + " outside 10000..1000000 bit/s");
+    return;
+  }
   broker::AttachOptions attach;
+  attach.bitrate = hello.bitrate();
   switch (hello.role()) {
     case wire::ROLE_UNSPECIFIED:
     case wire::ROLE_NODE:
@@ -262,8 +282,23 @@ void NodeSession::OnHello(const wire::Hello& hello) {
   filling_.AddHelloReply(reply);
   ScheduleFlush();
   stats_->attached++;
-  spdlog::info("{}: attached ({}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
-               hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string());
+  spdlog::info("{}: attached ({}{}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
+               hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string(),
+               RateNote(hello.bitrate(), bus.bitrate));
+}
+
+void NodeSession::OnBitRate(std::uint32_t bitrate) {
+  if (!ValidBitrate(bitrate)) {
+    ProtocolError("bit rate " + std::to_string(bitrate) + " outside 10000..1000000 bit/s");
+    return;
+  }
+  broker_.SetPortBitrate(port_, bitrate);
+  const std::uint32_t bus = broker_.Stats(bus_, 0).bitrate;
+  // A node stating the bus's own rate (commissioned for it) is routine; another rate is news.
+  const bool other = bitrate != 0 && bitrate != bus;
+  spdlog::log(other ? spdlog::level::info : spdlog::level::debug, "{}: controller now at {} bit/s{}", label_,
+              other ? bitrate : bus,
+              other ? " (the bus runs at " + std::to_string(bus) + ")" : std::string());
 }
 
 void NodeSession::Refuse(const std::string& reason) {

@@ -78,6 +78,8 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>, publ
   void Handle(const wire::Message& message);
   void OnHello(const wire::Hello& hello);
   void OnNodeReply(const wire::NodeReply& reply);
+  /// BitRate: the node's controller switched rate (0: back to the bus's).
+  void OnBitRate(std::uint32_t bitrate);
   /// Closing: every pending request ends with nullopt.
   void FailPendingRequests();
   void Refuse(const std::string& reason);

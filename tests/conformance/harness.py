@@ -27,6 +27,8 @@ STARTUP_TIMEOUT = 60.0
 BOOT_TIMEOUT = 30.0
 SDO_TIMEOUT = 5.0
 WAIT_TIMEOUT = 30.0
+# Bit rate of the suite's buses: the factory rate of every variant (registry.cpp, each manual).
+FACTORY_BITRATE = 125_000
 
 
 def wait_until(predicate: Callable[[], object], timeout: float = WAIT_TIMEOUT, step: float = 0.05):
@@ -111,13 +113,16 @@ class Fleet:
             "# only watches (no configuration, no NMT start); the suite starts the nodes itself.",
             'name: "conformance"',
             "orchestrator { start_nodes: false }",
-            f'bus {{ name: "{self.bus}" bitrate: 500000 socketcand_port: {self.socketcand_port} }}',
+            # The variants' factory bit rate (every manual: 125 kbit/s): a node nobody configured is
+            # commissioned for its bus, so 5B50h (the bit rate, UMAX020411A §3.4.110) reads its EDS
+            # default only on a bus at the factory rate, as a device fresh from the factory would.
+            f'bus {{ name: "{self.bus}" bitrate: {FACTORY_BITRATE} socketcand_port: {self.socketcand_port} }}',
         ]
         # A device with several CAN ports has its port 1 on can0 (python-canopen's bus) and each
         # further port on a bus of its own (can1, ...) without a socketcand endpoint: the suite
         # checks port 1.
         for p in range(1, max(v.ports for v in variants)):
-            lines.append(f'bus {{ name: "{self.port_bus(p)}" bitrate: 500000 }}')
+            lines.append(f'bus {{ name: "{self.port_bus(p)}" bitrate: {FACTORY_BITRATE} }}')
         for v in variants:
             kind = f'device: "{v.device}"' if v.device else f'eds: "{v.eds}"'
             buses = " ".join(f'bus: "{self.port_bus(p)}"' for p in range(v.ports))

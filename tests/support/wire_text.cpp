@@ -67,6 +67,7 @@ std::string WireText(const wire::Hello& m) {
       .Uint("node_id", m.node_id())
       .Enum("role", m.role(), wire::Role_Name(m.role()))
       .Bool("tx_confirmations", m.tx_confirmations())
+      .Uint("bitrate", m.bitrate())
       .Take();
 }
 

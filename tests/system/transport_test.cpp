@@ -576,5 +576,70 @@ TEST_F(Transport, ANodeReplyBeforeHelloOrANodeRequestFromANodeIsAProtocolError) 
   EXPECT_EQ(server.Stats().protocol_errors, 2u);
 }
 
+// Protocol v3: a node states its controller's bit rate in its Hello and each switch in a
+// BitRate message; the broker runs its port at that rate (orchestrator/broker/README.md "Bit
+// rate"): at another rate than the bus, the node sees error frames and no traffic, and logs them.
+TEST_F(Transport, ANodeAtAnotherBitRateSeesErrorFramesUntilItSwitchesBack) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  BrokerClientOptions options;
+  options.endpoint = ep;
+  options.node_name = "b";
+  options.bitrate = 250'000;  // the bus runs at 1 Mbit/s
+  BrokerClientPort b(io_, options);
+  std::vector<std::string> seen;
+  b.OnReceive([&](const CanFrame& f, BusTime) { seen.push_back(ToCandump(f) + (f.error() ? "!" : "")); });
+  auto a = Client(ep, "a");
+  auto c = Client(ep, "c");
+  ASSERT_TRUE(RunUntil([&] { return a->Connected() && b.Connected() && c->Connected(); }));
+  const auto port = broker_.NewestPortNamed("can0", "b");
+  ASSERT_TRUE(port.has_value());
+  EXPECT_EQ(broker_.Port(*port).bitrate, 250'000u);
+
+  ASSERT_TRUE(a->Send(CanFrame::Data(0x181, {0xAA})));
+  ASSERT_TRUE(RunUntil([&] { return !seen.empty(); }));
+  EXPECT_EQ(seen, (std::vector<std::string>{"181#!"}));
+  EXPECT_EQ(b.Stats().rx_error_frames, 1u);
+
+  ASSERT_TRUE(b.SetBitRate(0));  // back to the bus's rate
+  EXPECT_EQ(b.BitRate(), 0u);
+  ASSERT_TRUE(RunUntil([&] { return broker_.Port(*port).bitrate == 1'000'000u; }));
+  ASSERT_TRUE(a->Send(CanFrame::Data(0x181, {0xBB})));
+  ASSERT_TRUE(RunUntil([&] { return seen.size() == 2; }));
+  EXPECT_EQ(seen[1], "181#BB");
+  EXPECT_FALSE(b.SetBitRate(5'000));  // outside 10 kbit/s .. 1 Mbit/s: not the port's to take
+}
+
+// A Hello with a rate the broker cannot run is refused; a BitRate message with one is a protocol
+// error (canfleet_wire.proto).
+TEST_F(Transport, ABitRateOutsideTheRangeIsRefused) {
+  transport::BrokerServer server(io_, broker_);
+  const std::string ep = Listen(server);
+  std::atomic<int> closed = 0;
+  std::thread peer([&] {
+    {
+      RawConnection raw(ep);
+      wire::MessageWriter w;
+      wire::Hello hello = wire::MakeHello("can0", "too-fast");
+      hello.set_bitrate(2'000'000);
+      w.AddHello(hello);
+      raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+      if (raw.ReadUntilClosed().closed) ++closed;
+    }
+    {
+      RawConnection raw(ep);
+      wire::MessageWriter w;
+      w.AddHello(wire::MakeHello("can0", "then-too-slow"));
+      w.AddBitRate(1'000);
+      raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+      if (raw.ReadUntilClosed().closed) ++closed;
+    }
+  });
+  ASSERT_TRUE(RunUntil([&] { return closed.load() == 2; }));
+  peer.join();
+  EXPECT_EQ(server.Stats().refused, 1u);
+  EXPECT_EQ(server.Stats().protocol_errors, 1u);
+}
+
 }  // namespace
 }  // namespace canfleet::system_test

@@ -52,6 +52,14 @@ std::string Process(const control::NodeStatus& node) {
   return text;
 }
 
+/// The CONTROLLER column: the state, and the port's bit rate when it is not its bus's
+/// ("error-passive @250k": a node at the wrong rate sees no traffic).
+std::string ControllerText(const control::PortStatus& port) {
+  std::string text = port.controller().empty() ? "-" : port.controller();
+  if (port.bitrate() != 0) text += " @" + FormatBitrate(port.bitrate());
+  return text;
+}
+
 /// `node` is a NodeStatus or a PortStatus.
 template <class Node>
 std::string LastEmcy(const Node& node) {
@@ -163,16 +171,18 @@ std::string FormatStatus(const control::Status& status) {
           nodes.AddRow({first ? n.name() : "  port " + std::to_string(p + 1), first ? n.device() : "",
                         std::to_string(port.node_id()), port.bus(), first ? Process(n) : "",
                         first && n.pid() != 0 ? std::to_string(n.pid()) : (first ? "-" : ""),
-                        port.nmt_state().empty() ? "-" : port.nmt_state(),
-                        port.controller().empty() ? "-" : port.controller(), std::to_string(port.tec()),
-                        std::to_string(port.rec()), FormatSeconds(port.heartbeat_age_s()), LastEmcy(port)});
+                        port.nmt_state().empty() ? "-" : port.nmt_state(), ControllerText(port),
+                        std::to_string(port.tec()), std::to_string(port.rec()),
+                        FormatSeconds(port.heartbeat_age_s()), LastEmcy(port)});
         }
         continue;
       }
-      nodes.AddRow({n.name(), n.device(), Join(n.node_ids()), Join(n.buses()), Process(n),
-                    n.pid() != 0 ? std::to_string(n.pid()) : "-", n.nmt_state().empty() ? "-" : n.nmt_state(),
-                    n.controller().empty() ? "-" : n.controller(), std::to_string(n.tec()),
-                    std::to_string(n.rec()), FormatSeconds(n.heartbeat_age_s()), LastEmcy(n)});
+      nodes.AddRow(
+          {n.name(), n.device(), Join(n.node_ids()), Join(n.buses()), Process(n),
+           n.pid() != 0 ? std::to_string(n.pid()) : "-", n.nmt_state().empty() ? "-" : n.nmt_state(),
+           n.ports_size() == 1 ? ControllerText(n.ports(0)) : (n.controller().empty() ? "-" : n.controller()),
+           std::to_string(n.tec()), std::to_string(n.rec()), FormatSeconds(n.heartbeat_age_s()),
+           LastEmcy(n)});
     }
     out += nodes.Render();
   }

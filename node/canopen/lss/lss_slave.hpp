@@ -80,6 +80,12 @@ class LssSlave {
 
   /// The node-ID the stack now runs with (after reset communication); also becomes the pending ID.
   void SetActiveNodeId(std::uint8_t node_id);
+  /// The bit timing the port now runs at (set by the stack, e.g. from a device object at reset);
+  /// also becomes the pending one, as after an activation.
+  void SetBitTiming(std::uint8_t bit_timing_index) {
+    active_bit_timing_ = bit_timing_index;
+    pending_bit_timing_ = bit_timing_index;
+  }
   /// Replaces the LSS address (e.g. after the device wrote a new serial number to 1018h).
   void SetAddress(const LssAddress& address) { address_ = address; }
 

@@ -11,10 +11,11 @@ std::unique_ptr<ParameterStore> MakeStore(ObjectDictionary& od, const std::files
 
 // A node-ID configured by LSS and stored (CiA 305 "store configuration") survives restarts and
 // wins over the command line, as on a real device whose ID was set by a master.
-std::uint8_t InitialNodeId(StackOptions& options, const ParameterStore* store) {
+std::uint8_t InitialNodeId(StackOptions& options, const ParameterStore* store, bool& bit_timing_stored) {
   if (store) {
     if (auto stored = store->LoadLssConfig()) {
       options.bit_timing_index = stored->second;
+      bit_timing_stored = true;
       return stored->first;
     }
   }
@@ -38,7 +39,7 @@ CanopenStack::CanopenStack(ObjectDictionary& od, BusPort& port, Scheduler& sched
       hooks_(std::move(hooks)),
       policy_(policy ? std::move(policy) : std::make_shared<ErrorPolicy>()),
       store_(MakeStore(od, options_.state_dir)),
-      node_id_(InitialNodeId(options_, store_.get())),
+      node_id_(InitialNodeId(options_, store_.get(), bit_timing_stored_)),
       nmt_(port, node_id_,
            NmtSlave::Callbacks{[this] { ResetApplication(); }, [this] { ResetCommunication(); },
                                [this](NmtState s) { OnStateChanged(s); }}),
@@ -55,10 +56,21 @@ CanopenStack::CanopenStack(ObjectDictionary& od, BusPort& port, Scheduler& sched
                                                           return store_ && store_->SaveLssConfig(id, timing);
                                                         },
                                                         [this](std::uint8_t timing) {
-                                                          options_.bit_timing_index = timing;
+                                                          SetBitTiming(timing);
                                                           if (hooks_.on_bit_timing)
                                                             hooks_.on_bit_timing(timing);
                                                         }});
+  SetBitRateObject(options_.bit_timing_index);
+  // Only CiA 305 table-0 indexes are bit rates (UMAX020411A Table 32: 5 is reserved).
+  if (options_.bit_rate_object) {
+    if (SubObject* sub = od_.Find(options_.bit_rate_object->index, options_.bit_rate_object->sub_index)) {
+      sub->validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+        const std::uint64_t value = DecodeUnsignedLe(data);
+        return value <= 0xFF && BitRateKbit(static_cast<std::uint8_t>(value)) ? SdoAbort::kNone
+                                                                              : SdoAbort::kInvalidValue;
+      });
+    }
+  }
   if (!store_) RefuseStorageWithoutStateDir();
   sync_.OnSync([this](std::uint8_t counter) { pdo_.OnSync(counter); });
   port_.OnReceive([this](const CanFrame& frame, BusTime) { OnFrame(frame); });
@@ -82,7 +94,45 @@ void CanopenStack::ResetApplication() {
   ApplyStored(0x2000, 0xFFFF);
   emcy_.ClearAll();
   if (hooks_.on_reset_application) hooks_.on_reset_application();
+  ApplyBitRateObject();
   ResetCommunication();
+}
+
+// The Axiomatic manuals' 5B50h (UMAX020411A §3.4.110, UMAX181001 §3.4.79, UMAX080311 §2.4 table):
+// "could be configured to different baud rates by changing the value in this object", without
+// saying when. The product reads it as it reads every parameter: at reset, from what was stored
+// (§3.2 1010h: changes not stored "will be lost on the next power cycle"; 1011h: "set valid only
+// after the device is reset or power-cycled"). Unlike LSS there is no switch delay: the controller
+// starts at the new rate, as after a power cycle.
+void CanopenStack::ApplyBitRateObject() {
+  if (!options_.bit_rate_object) return;
+  const auto [index, sub] = *options_.bit_rate_object;
+  if (od_.Find(index, sub) == nullptr) return;
+  const std::uint64_t value = od_.GetUnsigned(index, sub);
+  if (value > 0xFF || !BitRateKbit(static_cast<std::uint8_t>(value))) return;  // not a table-0 index
+  const auto timing = static_cast<std::uint8_t>(value);
+  if (timing == options_.bit_timing_index) return;
+  SetBitTiming(timing);
+  if (hooks_.on_bit_timing) hooks_.on_bit_timing(timing);
+}
+
+void CanopenStack::SetBitTiming(std::uint8_t index) {
+  options_.bit_timing_index = index;
+  lss_->SetBitTiming(index);
+  SetBitRateObject(index);
+}
+
+void CanopenStack::AdoptBitTiming(std::uint8_t index) {
+  SetBitTiming(index);
+}
+
+void CanopenStack::SetBitRateObject(std::uint8_t index) {
+  if (!options_.bit_rate_object) return;
+  SubObject* sub = od_.Find(options_.bit_rate_object->index, options_.bit_rate_object->sub_index);
+  if (sub == nullptr) return;
+  sub->default_value = EncodeLe(index, FixedSize(sub->type).value_or(1));
+  sub->default_adds_node_id = false;
+  sub->value = sub->default_value;
 }
 
 // Reset communication restores the communication area (1000h–1FFFh) and restarts every
@@ -139,6 +189,9 @@ void CanopenStack::ApplyNodeId(std::uint8_t node_id) {
 }
 
 void CanopenStack::OnFrame(const CanFrame& frame) {
+  // An error frame (a node at another bit rate than its bus sees them instead of traffic) carries
+  // an identifier but no message: no service may take it for one (a heartbeat, an LSS request).
+  if (frame.error()) return;
   if (lss_->OnFrame(frame)) return;
   if (!Configured()) return;
   if (nmt_.OnFrame(frame)) return;

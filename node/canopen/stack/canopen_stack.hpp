@@ -31,11 +31,27 @@ namespace canfleet::canopen {
 /// The node-ID of an LSS slave that has none yet (CiA 305 §3.4).
 inline constexpr std::uint8_t kUnconfiguredNodeId = 0xFF;
 
+/// A device object that holds the port's bit rate as a CiA 305 table-0 index (the Axiomatic
+/// manuals' 5B50h "Change Baud Rate", Table 32 of UMAX020411A: 0 = 1 Mbit/s ... 4 = 125 kbit/s ...
+/// 8 = 10 kbit/s). See StackOptions::bit_rate_object.
+struct BitRateObject {
+  std::uint16_t index = 0;
+  std::uint8_t sub_index = 0;
+};
+
 struct StackOptions {
   /// 1..127, or kUnconfiguredNodeId: the node then runs only LSS until a master assigns an ID.
   std::uint8_t node_id = kUnconfiguredNodeId;
   /// LSS bit timing index (CiA 305 table 0: 0 = 1 Mbit/s ... 4 = 125 kbit/s).
   std::uint8_t bit_timing_index = 4;
+  /// The device's bit-rate object, if it has one. Its value is the bit rate the port runs at
+  /// from the next reset application (power-on, NMT reset node) on: after the stored parameters
+  /// are applied, a value that differs from the active index switches the port (on_bit_timing).
+  /// A written value therefore takes effect at the next reset only if it was stored (1010h): the
+  /// reset restores the manufacturer area to its stored values, as every other object's (the
+  /// manuals' 1010h: unsaved changes are lost). Its default is the active bit timing (the factory
+  /// or LSS-stored rate, then each LSS activation), so an unstored object follows LSS.
+  std::optional<BitRateObject> bit_rate_object;
   /// Per-node folder for stored parameters (1010h/1011h) and LSS configuration; empty = none.
   std::filesystem::path state_dir;
   SdoServerOptions sdo;
@@ -54,7 +70,8 @@ struct StackHooks {
   std::function<void(const CommError&, bool)> on_comm_error;
   /// Stored parameters that could not be applied (corrupt file, missing object...): one line each.
   std::function<void(const std::string&)> on_storage_issue;
-  /// LSS "activate bit timing" completed: the port should switch to this CiA 305 table-0 index.
+  /// The port should switch to this CiA 305 table-0 index: LSS "activate bit timing" completed,
+  /// or the bit-rate object (StackOptions::bit_rate_object) holds another rate at reset.
   std::function<void(std::uint8_t bit_timing_index)> on_bit_timing;
 };
 
@@ -70,6 +87,14 @@ class CanopenStack final : private CommErrorSink {
 
   NmtState State() const { return nmt_.State(); }
   std::uint8_t NodeId() const { return node_id_; }
+  /// The CiA 305 table-0 index the port runs at.
+  std::uint8_t BitTimingIndex() const { return options_.bit_timing_index; }
+  /// Whether that index came from a stored LSS configuration (CiA 305 store configuration) rather
+  /// than from StackOptions.
+  bool BitTimingStored() const { return bit_timing_stored_; }
+  /// Takes `index` as the port's bit timing before Start(), without on_bit_timing (the port already
+  /// runs at it): e.g. a node whose rate nobody configured, commissioned for the bus it is on.
+  void AdoptBitTiming(std::uint8_t index);
   ObjectDictionary& od() { return od_; }
   Emcy& emcy() { return emcy_; }
   PdoService& pdo() { return pdo_; }
@@ -93,6 +118,12 @@ class CanopenStack final : private CommErrorSink {
   void Boot();
   void ApplyNodeId(std::uint8_t node_id);
   void ApplyStored(std::uint16_t first, std::uint16_t last);
+  /// Reset application: the bit-rate object's value, if it differs from the active index, becomes
+  /// the port's rate.
+  void ApplyBitRateObject();
+  /// Sets the bit-rate object's default and value to `index`.
+  void SetBitRateObject(std::uint8_t index);
+  void SetBitTiming(std::uint8_t index);
   void RefuseStorageWithoutStateDir();
   bool Configured() const { return node_id_ >= 1 && node_id_ <= 127; }
 
@@ -103,6 +134,7 @@ class CanopenStack final : private CommErrorSink {
   StackHooks hooks_;
   std::shared_ptr<const ErrorPolicy> policy_;
   std::unique_ptr<ParameterStore> store_;
+  bool bit_timing_stored_ = false;
   std::uint8_t node_id_;
   ControllerEvent controller_;
 

@@ -68,6 +68,9 @@ void DataLogger::ConfigureStack(std::size_t port, StackSetup& setup) {
     return shared_od_ != nullptr && shared_od_->GetUnsigned(kStartOperational, sub) != 0;
   };
   setup.hooks.on_reset_application = [this, port] { OnResetApplication(port); };
+  // §3.4.79: 5B50h sub 1 is CAN1's bit rate, sub 2 CAN2's (Table 25 indexes), either written from
+  // either port; each port runs at its sub's stored value from its next reset (README).
+  setup.options.bit_rate_object = canopen::BitRateObject{kChangeBaudRate, sub};
 }
 
 void DataLogger::Attach(DeviceContext& context) {

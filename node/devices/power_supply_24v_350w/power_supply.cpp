@@ -63,6 +63,9 @@ void PowerSupply::ConfigureStack(std::size_t port, StackSetup& setup) {
   // §2.4.17: 5555h TRUE boots straight into operational.
   setup.options.start_operational = [this] { return od_->GetUnsigned(ps::kStartInOperational, 0) != 0; };
   setup.hooks.on_reset_application = [this] { OnResetApplication(); };
+  // §2.4 table: 5B50h "Change Baud Rate" (Table 8 indexes); the port runs at its stored value from
+  // the next reset (README).
+  setup.options.bit_rate_object = canopen::BitRateObject{ps::kChangeBaudRate, 0};
   // §1.2.2: sleep is never allowed in operational; a state change may allow or end it.
   setup.hooks.on_state_changed = [this](canopen::NmtState) { RequestStep(); };
 }

@@ -51,6 +51,9 @@ void ValveController::ConfigureStack(std::size_t port, StackSetup& setup) {
   // §3.4.109: 5555h TRUE starts in operational without a master.
   setup.options.start_operational = [this] { return od_->GetUnsigned(valve::kStartOperational, 0) != 0; };
   setup.hooks.on_reset_application = [this] { OnResetApplication(); };
+  // §3.4.110: 5B50h "Change Baud Rate" (Table 32 indexes); the port runs at its stored value from
+  // the next reset (README).
+  setup.options.bit_rate_object = canopen::BitRateObject{valve::kChangeBaudRate, 0};
   setup.hooks.on_state_changed = [this](canopen::NmtState) { RequestRun(); };
   setup.hooks.on_comm_error = [this](const canopen::CommError& error, bool active) {
     OnCommError(error, active);

@@ -203,6 +203,7 @@ inline constexpr std::uint16_t kTemperatureOver = 0x5032;
 inline constexpr std::uint16_t kTemperatureHysteresis = 0x5033;
 inline constexpr std::uint16_t kAutoUpdate = 0x5550;
 inline constexpr std::uint16_t kStartOperational = 0x5555;
+inline constexpr std::uint16_t kChangeBaudRate = 0x5B50;  ///< §3.4.110, Table 32 indexes
 
 // ---- Errors (§3.2.4 Table 33): 1003h = description << 24 | channel << 16 | EMCY code ----
 inline constexpr std::uint16_t kEmcyInputOverload = 0xF001;   ///< AI out of range

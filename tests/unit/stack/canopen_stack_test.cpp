@@ -241,5 +241,155 @@ TEST_F(StoredStackTest, SavedParametersSurviveARestart) {
   EXPECT_EQ(od.GetUnsigned(0x2000, 0), 42u);
 }
 
+// An error frame (what a port at another bit rate than its bus receives instead of traffic,
+// orchestrator/broker/README.md "Bit rate") carries an identifier but is no message: an error
+// frame on 000h is no NMT command, one on 7E5h no LSS request.
+TEST_F(StackTest, ErrorFramesAreNoMessages) {
+  stack->Start();
+  master.Clear();
+  CanFrame stop = test::Frame("000#0205");
+  stop.flags |= CanFrame::kError;
+  master.Send(stop);
+  CanFrame sdo = test::Frame("605#4000100000000000");
+  sdo.flags |= CanFrame::kError;
+  master.Send(sdo);
+  EXPECT_EQ(stack->State(), NmtState::kPreOperational);
+  EXPECT_EQ(master.Count(), 0u);
+}
+
+// A device's bit-rate object (the Axiomatic 5B50h "Change Baud Rate", UMAX020411A §3.4.110, a
+// CiA 305 table-0 index): StackOptions::bit_rate_object.
+class BitRateObjectTest : public StoredStackTest {
+ protected:
+  static void BuildWithBitRateObject(ObjectDictionary& od) {
+    BuildOd(od);
+    od.AddVar(0x5B50, "Change Baud Rate", DataType::kUnsigned8, Access::kRw, EncodeLe<std::uint8_t>(4));
+  }
+  StackOptions WithObject() const {
+    StackOptions options = Options();
+    options.bit_timing_index = 4;  // the factory's 125 kbit/s
+    options.bit_rate_object = BitRateObject{0x5B50, 0};
+    return options;
+  }
+  StackHooks Recording() {
+    StackHooks hooks;
+    hooks.on_bit_timing = [this](std::uint8_t index) { switches.push_back(index); };
+    return hooks;
+  }
+  std::vector<std::uint8_t> switches;
+};
+
+// Written alone, 5B50h changes nothing, not even at the next reset: the reset restores the
+// manufacturer area to its stored values (the manuals' 1010h: unsaved changes are lost). Stored
+// (1010h), it is the bit rate from the next reset on (NMT reset node), with on_bit_timing; and
+// after a restart of the process (power-on) too.
+TEST_F(BitRateObjectTest, AStoredValueTakesEffectAtTheNextResetAndAfterPowerOn) {
+  {
+    SimulatedScheduler scheduler;
+    LoopbackBus bus;
+    auto& port = bus.Attach("node");
+    test::BusProbe master(bus);
+    ObjectDictionary od;
+    BuildWithBitRateObject(od);
+    CanopenStack stack(od, port, scheduler, WithObject(), Recording());
+    stack.Start();
+    EXPECT_TRUE(switches.empty());
+    EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 4u);  // the active index
+    master.Clear();
+    master.Send("605#2F505B0003000000");  // 5B50h = 3 (250 kbit/s)
+    EXPECT_EQ(master.Next(), "585#60505B0000000000");
+    EXPECT_TRUE(switches.empty());  // not before a reset
+    master.Send("000#8105");        // NMT reset node
+    EXPECT_TRUE(switches.empty());  // not stored: lost
+    EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 4u);
+
+    master.Send("605#2F505B0003000000");
+    master.Send("605#2310100173617665");  // 1010h.1 = "save"
+    master.Clear();
+    master.Send("000#8105");
+    EXPECT_EQ(switches, (std::vector<std::uint8_t>{3}));
+    EXPECT_EQ(stack.BitTimingIndex(), 3u);
+    EXPECT_EQ(stack.lss().ActiveBitTimingIndex(), 3u);
+    EXPECT_EQ(master.Next(), "705#00");  // boots again (at the new rate)
+    master.Send("000#8105");
+    EXPECT_EQ(switches.size(), 1u);  // already at 3
+  }
+  switches.clear();
+  SimulatedScheduler scheduler;
+  LoopbackBus bus;
+  auto& port = bus.Attach("node");
+  ObjectDictionary od;
+  BuildWithBitRateObject(od);
+  CanopenStack stack(od, port, scheduler, WithObject(), Recording());
+  stack.Start();
+  EXPECT_EQ(switches, (std::vector<std::uint8_t>{3}));
+  EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 3u);
+}
+
+// Only CiA 305 table-0 indexes are bit rates: 5 is reserved (UMAX020411A Table 32), 9 and above
+// are none (06090030h invalid value).
+TEST_F(BitRateObjectTest, AReservedIndexIsRefused) {
+  SimulatedScheduler scheduler;
+  LoopbackBus bus;
+  auto& port = bus.Attach("node");
+  test::BusProbe master(bus);
+  ObjectDictionary od;
+  BuildWithBitRateObject(od);
+  CanopenStack stack(od, port, scheduler, WithObject(), Recording());
+  stack.Start();
+  master.Clear();
+  master.Send("605#2F505B0005000000");
+  EXPECT_EQ(master.Next(), "585#80505B0030000906");
+  master.Send("605#2F505B0009000000");
+  EXPECT_EQ(master.Next(), "585#80505B0030000906");
+  master.Send("605#2F505B0008000000");
+  EXPECT_EQ(master.Next(), "585#60505B0000000000");
+}
+
+// CiA 305 §8.3.2 "activate bit timing": the port switches after the first delay, and the
+// bit-rate object follows (its default too), so a later NMT reset keeps the activated rate
+// (only a power-off loses it unless LSS stored it).
+TEST_F(BitRateObjectTest, LssActivationIsTheObjectsNewValueAndSurvivesAReset) {
+  SimulatedScheduler scheduler;
+  LoopbackBus bus;
+  auto& port = bus.Attach("node");
+  test::BusProbe master(bus);
+  ObjectDictionary od;
+  BuildWithBitRateObject(od);
+  CanopenStack stack(od, port, scheduler, WithObject(), Recording());
+  stack.Start();
+  master.Clear();
+  master.Send("7E5#0401000000000000");  // switch state global: configuration
+  master.Send("7E5#1300020000000000");  // configure bit timing: table 0, index 2 (500 kbit/s)
+  EXPECT_EQ(master.Next(), "7E4#1300000000000000");
+  master.Send("7E5#150A000000000000");  // activate bit timing, 10 ms switch delay
+  EXPECT_TRUE(switches.empty());
+  scheduler.Advance(10ms);
+  EXPECT_EQ(switches, (std::vector<std::uint8_t>{2}));
+  EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 2u);
+  scheduler.Advance(10ms);
+  master.Send("000#8105");
+  EXPECT_EQ(switches.size(), 1u);
+  EXPECT_EQ(stack.BitTimingIndex(), 2u);
+  EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 2u);
+}
+
+// A node commissioned for its bus (node/process/bit_rate_commissioning.hpp) adopts its rate before
+// power-on: no switch, the object and LSS report it.
+TEST_F(BitRateObjectTest, AdoptedBitTimingIsTheObjectsValue) {
+  SimulatedScheduler scheduler;
+  LoopbackBus bus;
+  auto& port = bus.Attach("node");
+  ObjectDictionary od;
+  BuildWithBitRateObject(od);
+  CanopenStack stack(od, port, scheduler, WithObject(), Recording());
+  stack.AdoptBitTiming(2);
+  stack.Start();
+  EXPECT_TRUE(switches.empty());
+  EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 2u);
+  EXPECT_EQ(stack.lss().ActiveBitTimingIndex(), 2u);
+  EXPECT_EQ(stack.lss().PendingBitTimingIndex(), 2u);
+}
+
 }  // namespace
 }  // namespace canfleet::canopen

@@ -27,6 +27,7 @@ Bytes MixedStream() {
   MessageWriter w;
   Hello hello = MakeHello("can0", "quad-5", 5);
   hello.set_tx_confirmations(true);
+  hello.set_bitrate(125'000);
   w.AddHello(hello);
   HelloReply reply;
   reply.set_accepted(true);
@@ -59,13 +60,14 @@ Bytes MixedStream() {
   value.set_input(true);
   w.AddNodeReply(node_reply);
   w.AddFrame(Frame("182#BB"), BusTime(7000));
+  w.AddBitRate(250'000);
   w.AddError("bye");
   return ToBytes(w.Bytes());
 }
 
 const std::vector<std::string> kMixedExpected = {
-    R"(Hello protocol_version: 2 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true)",
-    "HelloReply accepted: true protocol_version: 2 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
+    R"(Hello protocol_version: 3 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true bitrate: 125000)",
+    "HelloReply accepted: true protocol_version: 3 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
     "FrameBatch 123#DEADBEEF@1000 7FF#@2000 1FFFFFFF#0102030405060708@3000 701#R1@4000",
     "TxConfirm 185#01@4500",
     "FrameBatch 080#@5000",
@@ -76,6 +78,7 @@ const std::vector<std::string> kMixedExpected = {
     R"(NodeRequest request_id: 7 io_set { name: "AIN1.voltage_mV" value: "3000" })",
     R"(NodeReply request_id: 7 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })",
     "FrameBatch 182#BB@7000",
+    "BitRate 250000",
     "Error bye",
 };
 

@@ -60,6 +60,9 @@ inline std::string Describe(const Message& m) {
     case MessageType::kNodeReply:
       out += " " + canfleet::test::WireText(m.envelope.node_reply());
       break;
+    case MessageType::kBitRate:
+      out += " " + std::to_string(m.envelope.bit_rate().bitrate());
+      break;
   }
   return out;
 }
