@@ -37,11 +37,18 @@ std::string Consumers(const NodeStatusSample& s) {
   return text;
 }
 
-/// "AIN1.voltage_mV   1200 mV", padded to `width`.
-std::string IoCell(const telemetry::IoValueSample& v, int width) {
+/// "AIN1.voltage_mV      1200 mV": the name in `name_width`, the value and unit after it.
+std::string IoCell(const telemetry::IoValueSample& v, int name_width) {
   const std::string value = FormatIoValue(v.value) + (v.unit.empty() ? "" : " " + v.unit);
-  const int name_width = std::max(1, width - 16);
-  return Printf("%-*.*s %14s ", name_width, name_width, v.name.c_str(), value.c_str());
+  return Printf("%-*.*s %12s", name_width, name_width, v.name.c_str(), value.c_str());
+}
+
+/// The longest name of `values`, at most `limit`.
+int NameWidth(const std::vector<telemetry::IoValueSample>& values, int limit) {
+  std::size_t longest = 1;
+  for (const auto& v : values)
+    longest = std::max(longest, v.name.size());
+  return std::min(static_cast<int>(longest), std::max(1, limit));
 }
 
 }  // namespace
@@ -100,16 +107,20 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
     top.push_back(Fit("simulated I/O: none published (a generic node has none)", width));
   } else {
     const auto& io = *row.io;
-    const int column = std::max(20, width / 2);
+    // The outputs start 4 columns after the longest input cell, at most at half the width.
+    const int half = std::max(20, width / 2);
+    const int in_width = NameWidth(io.inputs, half - 17);
+    const int out_width = NameWidth(io.outputs, half - 17);
+    const int column = std::min(half, std::max(24, in_width + 13 + 4));
     top.push_back(
         paint(kBold, Fit(Printf("%-*s%s", column, Printf("SIMULATED INPUTS (%zu)", io.inputs.size()).c_str(),
                                 Printf("SIMULATED OUTPUTS (%zu)", io.outputs.size()).c_str()),
                          width)));
     const std::size_t lines = std::max(io.inputs.size(), io.outputs.size());
     for (std::size_t i = 0; i < lines; ++i) {
-      std::string line = i < io.inputs.size() ? IoCell(io.inputs[i], column - 1) : std::string();
+      std::string line = i < io.inputs.size() ? IoCell(io.inputs[i], in_width) : std::string();
       line.resize(static_cast<std::size_t>(column), ' ');
-      if (i < io.outputs.size()) line += IoCell(io.outputs[i], column - 1);
+      if (i < io.outputs.size()) line += IoCell(io.outputs[i], out_width);
       while (!line.empty() && line.back() == ' ')
         line.pop_back();
       top.push_back(Fit(line, width));
@@ -118,7 +129,7 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   top.push_back("");
 
   bottom.push_back(
-      Fit("1003h (the node's own error history) is not telemetry: read it with "
+      Fit("1003h, the node's error history, is not telemetry: "
           "`canfleet sdo read NODE 0x1003 1 u32` (sub 0: how many)",
           width));
   bottom.push_back(paint(kDim, Fit(help, width)));

@@ -228,6 +228,20 @@ void AddTopOptions(CLI::App& app, TopOptions& options) {
       ->capture_default_str();
   app.add_option("--width", options.width, "screen width (default: terminal)");
   app.add_option("--height", options.height, "screen height (default: terminal)");
+  app.add_option_function<std::string>(
+         "--node",
+         [&options](const std::string& text) {
+           const auto colon = text.rfind(':');
+           int id = -1;
+           try {
+             if (colon != std::string::npos && colon > 0) id = std::stoi(text.substr(colon + 1));
+           } catch (const std::exception&) {
+           }
+           if (id < 0 || id > 127) throw CLI::ValidationError("--node", "BUS:NODE-ID expected, e.g. can0:6");
+           options.node = NodeKey{text.substr(0, colon), static_cast<std::uint8_t>(id)};
+         },
+         "open on this node's detail view (BUS:NODE-ID, e.g. can0:6); with --once print it")
+      ->type_name("BUS:ID");
   app.add_option_function<int>(
       "--auto-page", [&options](int s) { options.auto_page = std::chrono::seconds(s); },
       "turn to the next page every N seconds");
@@ -252,6 +266,8 @@ int RunTop(const TopOptions& options) {
   settings.sort = options.sort;
   settings.reverse = options.reverse;
   settings.color = options.color == "always" || (options.color == "auto" && to_terminal);
+  settings.selected = options.node;
+  settings.detail = options.node.has_value();
   const auto update_size = [&] {
     settings.width = 132;
     settings.height = 50;
