@@ -155,6 +155,7 @@ void Fleet::Stop(std::function<void()> done) {
   // The scenario ends here: what was decided stays readable, nothing more runs or is judged.
   final_results_ = runner_->Results();
   final_origin_ = runner_->origin();
+  repeat_timer_.reset();
   scenario_taps_.clear();
   runner_.reset();
   supervisor_.StopAll(std::move(done));

@@ -45,6 +45,9 @@ struct FleetOptions {
   /// Wall-clock time of scheduler time 0 for dumps and captures: the process's one origin
   /// (host::BrokerHost::wall_origin), which socketcand uses too. Unset: read when the fleet starts.
   std::optional<WallTime> wall_origin;
+  /// Run the scenario again after topology.scenario_repeat_ms (`canfleet up`); false: once
+  /// (`canfleet test` judges one run).
+  bool repeat_scenario = false;
 };
 
 class Fleet final : public control::ControlHandler, public scenario::FleetProbe {
@@ -140,7 +143,10 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   std::unique_ptr<ExternalAdoption> adoption_;  ///< running external nodes that attach without a boot-up
   Captures captures_;
   void WatchScenario();
+  void RepeatScenario();
   std::unique_ptr<scenario::ScenarioRunner> runner_;
+  std::unique_ptr<Timer> repeat_timer_;  ///< the next run of a repeating scenario
+  int scenario_run_ = 1;
   std::vector<scenario::Result> final_results_;  ///< after Stop
   std::optional<TimePoint> final_origin_;
   std::vector<std::unique_ptr<ScenarioTap>> scenario_taps_;  ///< listen-only, one per bus, for expectations

@@ -32,6 +32,7 @@ void Fleet::WatchScenario() {
                 if (runner_->Expectations() > 0)
                   spdlog::info("scenario: every step ran, every expectation decided");
                 if (on_scenario_done_) on_scenario_done_();
+                RepeatScenario();
               },
       });
   if (runner_->Expectations() == 0) return;
@@ -41,9 +42,29 @@ void Fleet::WatchScenario() {
 
 void Fleet::StartScenario() {
   if (!options_.topology.scenario().empty())
-    spdlog::info("scenario: {} step(s), {} expectation(s)", options_.topology.scenario_size(),
-                 runner_->Expectations());
+    spdlog::info("scenario{}: {} step(s), {} expectation(s)",
+                 scenario_run_ > 1 ? " run " + std::to_string(scenario_run_) : "",
+                 options_.topology.scenario_size(), runner_->Expectations());
   runner_->Start();
+}
+
+void Fleet::RepeatScenario() {
+  const auto pause = std::chrono::milliseconds(options_.topology.scenario_repeat_ms());
+  if (!options_.repeat_scenario || pause.count() == 0 || options_.topology.scenario().empty()) return;
+  spdlog::info("scenario: runs again in {:.1f} s", std::chrono::duration<double>(pause).count());
+  // A fresh runner, not a rewound one: every window, anchor and verdict starts over. The old
+  // runner is destroyed by the timer, never inside its own done hook (which runs in it).
+  // One timer, re-armed: a run that ends as it starts re-arms it inside its own callback, which a
+  // Timer allows (replacing it there would not be).
+  if (!repeat_timer_)
+    repeat_timer_ = std::make_unique<Timer>(scheduler_, [this] {
+      scenario_taps_.clear();
+      runner_.reset();
+      ++scenario_run_;
+      WatchScenario();
+      StartScenario();
+    });
+  repeat_timer_->StartAfter(pause);
 }
 
 void Fleet::RunStep(const topology::Step& step) {

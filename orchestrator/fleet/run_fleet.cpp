@@ -103,6 +103,7 @@ int RunFleet(const UpOptions& options) {
     if (!options.no_start) fleet_options.node_binary = FindNodeBinary(options.node_binary);
     fleet_options.node_arguments = telemetry::DdsArguments(options.dds);
     fleet_options.wall_origin = host.wall_origin();
+    fleet_options.repeat_scenario = true;
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
     control_server = std::make_unique<control::ControlServer>(io, *fleet);

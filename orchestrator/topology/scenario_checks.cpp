@@ -1,6 +1,7 @@
 #include "orchestrator/topology/scenario_checks.hpp"
 
 #include <algorithm>
+#include <set>
 #include <vector>
 
 #include "orchestrator/control/fault_kinds.hpp"
@@ -35,6 +36,7 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
                          ")");
   }
   std::map<std::string, int> labels;  // label -> step that injects it
+  std::set<std::string> cleared;      // labels a later step clears
   for (int i : order) {
     const Step& step = facts_.spec.scenario(i);
     const Scope s = root.Child("scenario", step, i);
@@ -44,6 +46,11 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
         break;
       case Step::kClear:
         CheckClear(s.Child("clear", step.clear()), step.clear(), labels);
+        if (step.clear().label().empty())  // clears every fault active so far
+          for (const auto& [label, at] : labels)
+            cleared.insert(label);
+        else
+          cleared.insert(step.clear().label());
         break;
       case Step::kIo: {
         const Scope is = s.Child("io", step.io());
@@ -72,6 +79,23 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
       case Step::ACTION_NOT_SET:
         s.FailHere("a step needs an action: inject, clear, io, nmt, sdo or expect");
     }
+  }
+  CheckRepeat(root, labels, cleared);
+}
+
+void ScenarioChecks::CheckRepeat(const Scope& root, const std::map<std::string, int>& labels,
+                                 const std::set<std::string>& cleared) const {
+  if (facts_.spec.scenario_repeat_ms() == 0) return;
+  if (facts_.spec.scenario().empty()) root.Fail("scenario_repeat_ms", "there is no scenario to repeat");
+  // The next run injects the same labels again: one still active from the last run is refused
+  // by the fleet ("already active"), so the run that repeats must leave none behind.
+  for (const auto& [label, step] : labels) {
+    const control::FaultSpec& f = facts_.spec.scenario(step).inject();
+    if (cleared.contains(label) || control::IsOneShot(f)) continue;
+    root.Child("scenario", facts_.spec.scenario(step), step)
+        .Child("inject", f)
+        .Fail("label", "the scenario repeats (scenario_repeat_ms) but never clears " + Quote(label) +
+                           ": its next run could not inject it again");
   }
 }
 

@@ -6,6 +6,7 @@
 /// are checked as the nodes' own. Internal to the loader.
 
 #include <map>
+#include <set>
 #include <string>
 
 #include "orchestrator/control/canfleet_control.pb.h"
@@ -27,6 +28,9 @@ class ScenarioChecks {
   void CheckInject(const Scope& s, const control::FaultSpec& f, int step, std::map<std::string, int>& labels);
   static void CheckClear(const Scope& s, const control::FaultClear& c,
                          const std::map<std::string, int>& labels);
+  /// A repeating scenario (scenario_repeat_ms) has steps, and clears every lasting fault it labels.
+  void CheckRepeat(const Scope& root, const std::map<std::string, int>& labels,
+                   const std::set<std::string>& cleared) const;
 
   const TopologyFacts& facts_;
 };

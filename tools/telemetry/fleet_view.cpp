@@ -102,8 +102,9 @@ void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& me
     row.last_sample = meta.source_time;
     row.last_change = meta.source_time;
     if (auto early = early_emcy_.find(key); early != early_emcy_.end()) {
-      row.last_emcy = early->second.first;
-      row.last_emcy_time = early->second.second;
+      row.emcy_history = std::move(early->second);
+      row.last_emcy = row.emcy_history.back().sample;
+      row.last_emcy_time = row.emcy_history.back().time;
       early_emcy_.erase(early);
     }
     nodes_.emplace(key, std::move(row));
@@ -166,12 +167,18 @@ void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& me
 void FleetView::Apply(const EmcySample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events) {
   if (!meta.valid_data) return;
   auto it = nodes_.find({sample.bus, sample.node_id});
+  std::deque<EmcyRecord>& history =
+      it != nodes_.end() ? it->second.emcy_history : early_emcy_[NodeKey{sample.bus, sample.node_id}];
+  // Topics arrive in batches: keep the history in time order, like recent().
+  auto at = history.end();
+  while (at != history.begin() && std::prev(at)->time > meta.source_time)
+    --at;
+  history.insert(at, EmcyRecord{sample, meta.source_time});
+  while (history.size() > kEmcyHistory)
+    history.pop_front();
   if (it != nodes_.end()) {
     it->second.last_emcy = sample;
     it->second.last_emcy_time = meta.source_time;
-  } else {
-    early_emcy_.insert_or_assign(NodeKey{sample.bus, sample.node_id},
-                                 std::make_pair(sample, meta.source_time));
   }
   Emit({.time = meta.source_time,
         .kind = EventKind::kEmcy,

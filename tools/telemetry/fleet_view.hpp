@@ -54,6 +54,16 @@ struct FleetEvent {
   bool replay = false;
 };
 
+/// One EMCY of a node as the monitor received it (the Emcy topic), with its publication time.
+struct EmcyRecord {
+  EmcySample sample;
+  WallTime time{};
+};
+
+/// EMCYs kept per node: the Emcy topic's history depth (keep-last 32 per node, telemetry/QOS.md),
+/// so a monitor started late shows what the topic still holds.
+inline constexpr std::size_t kEmcyHistory = 32;
+
 struct NodeRow {
   NodeStatusSample status;
   bool alive = true;
@@ -62,6 +72,7 @@ struct NodeRow {
   WallTime last_change{};                 ///< latest NMT/controller/error-register change (or first sighting)
   std::optional<EmcySample> last_emcy{};  ///< latest Emcy event (the status carries the code too)
   WallTime last_emcy_time{};
+  std::deque<EmcyRecord> emcy_history{};  ///< oldest first, at most kEmcyHistory
   std::optional<IoSnapshotSample> io{};
 };
 
@@ -97,7 +108,7 @@ class FleetView {
   WallTime started_{};
   std::size_t recent_capacity_{};
   std::map<NodeKey, NodeRow> nodes_{};
-  std::map<NodeKey, std::pair<EmcySample, WallTime>> early_emcy_{};  ///< EMCYs of nodes not seen yet
+  std::map<NodeKey, std::deque<EmcyRecord>> early_emcy_{};  ///< EMCYs of nodes not seen yet
   std::map<std::string, BusRow> buses_{};
   std::deque<FleetEvent> recent_{};
   WallTime last_new_node_{};

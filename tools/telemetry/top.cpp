@@ -63,6 +63,44 @@ struct Keys {
   std::string escape;  // pending escape sequence
 };
 
+/// Moves the selection by `delta` rows and turns to its page.
+void Select(int delta, RenderSettings& settings, const FleetView& view) {
+  const auto rows = SelectRows(view, settings.filter, settings.sort, settings.reverse, settings.now);
+  settings.selected = MoveSelection(rows, settings.selected, delta);
+  if (!settings.selected) return;
+  const auto page =
+      PageOf(rows, *settings.selected, RowsPerPage(settings, static_cast<int>(view.buses().size() + 1)));
+  if (page) settings.page = *page;
+}
+
+/// A complete escape sequence (arrows "\x1b[A".."\x1b[D", PgUp "\x1b[5~", PgDn "\x1b[6~"; a lone
+/// Esc is decided by the caller when a read ends on it).
+void HandleEscape(const std::string& sequence, RenderSettings& settings, const FleetView& view) {
+  if (sequence == "\x1b") {
+    settings.detail = false;
+  } else if (sequence == "\x1b[A") {
+    Select(-1, settings, view);
+  } else if (sequence == "\x1b[B") {
+    Select(+1, settings, view);
+  } else if (sequence == "\x1b[C") {
+    if (settings.selected) settings.detail = true;
+  } else if (sequence == "\x1b[D") {
+    settings.detail = false;
+  } else if (sequence == "\x1b[5~") {
+    --settings.page;
+  } else if (sequence == "\x1b[6~") {
+    ++settings.page;
+  }
+}
+
+/// True once `sequence` (starting with Esc) is complete: CSI sequences end in a byte 40h..7Eh.
+bool EscapeComplete(const std::string& sequence) {
+  if (sequence.size() < 2) return false;
+  if (sequence.size() < 3) return false;
+  const char last = sequence.back();
+  return (last >= 0x40 && last <= 0x7e) || sequence.size() >= 8;
+}
+
 void HandleKey(char c, Keys& keys, RenderSettings& settings, const FleetView& view) {
   if (keys.editing) {
     if (c == '\n' || c == '\r') {
@@ -79,19 +117,31 @@ void HandleKey(char c, Keys& keys, RenderSettings& settings, const FleetView& vi
     }
     return;
   }
-  if (!keys.escape.empty() || c == 0x1b) {  // PgUp "\x1b[5~", PgDn "\x1b[6~"
+  if (keys.escape == "\x1b" && c != '[' && c != 'O') {  // Esc, then another key
+    HandleEscape(keys.escape, settings, view);
+    keys.escape.clear();
+  }
+  if (!keys.escape.empty() || c == 0x1b) {
     keys.escape += c;
-    if (keys.escape == "\x1b[5~") --settings.page;
-    if (keys.escape == "\x1b[6~") ++settings.page;
-    if (keys.escape.size() >= 4 ||
-        (keys.escape.size() >= 3 && keys.escape.back() != '5' && keys.escape.back() != '6')) {
+    if (EscapeComplete(keys.escape)) {
+      HandleEscape(keys.escape, settings, view);
       keys.escape.clear();
     }
+    return;
+  }
+  if (settings.detail) {  // the node detail screen: back, other nodes, quit
+    if (c == 'q') keys.quit = true;
+    if (c == 0x7f || c == 0x08) settings.detail = false;
     return;
   }
   switch (c) {
     case 'q':
       keys.quit = true;
+      break;
+    case '\n':
+    case '\r':
+      if (!settings.selected) Select(0, settings, view);
+      settings.detail = settings.selected.has_value();
       break;
     case 'n':
     case ' ':
@@ -178,6 +228,20 @@ void AddTopOptions(CLI::App& app, TopOptions& options) {
       ->capture_default_str();
   app.add_option("--width", options.width, "screen width (default: terminal)");
   app.add_option("--height", options.height, "screen height (default: terminal)");
+  app.add_option_function<std::string>(
+         "--node",
+         [&options](const std::string& text) {
+           const auto colon = text.rfind(':');
+           int id = -1;
+           try {
+             if (colon != std::string::npos && colon > 0) id = std::stoi(text.substr(colon + 1));
+           } catch (const std::exception&) {
+           }
+           if (id < 0 || id > 127) throw CLI::ValidationError("--node", "BUS:NODE-ID expected, e.g. can0:6");
+           options.node = NodeKey{text.substr(0, colon), static_cast<std::uint8_t>(id)};
+         },
+         "open on this node's detail view (BUS:NODE-ID, e.g. can0:6); with --once print it")
+      ->type_name("BUS:ID");
   app.add_option_function<int>(
       "--auto-page", [&options](int s) { options.auto_page = std::chrono::seconds(s); },
       "turn to the next page every N seconds");
@@ -202,6 +266,8 @@ int RunTop(const TopOptions& options) {
   settings.sort = options.sort;
   settings.reverse = options.reverse;
   settings.color = options.color == "always" || (options.color == "auto" && to_terminal);
+  settings.selected = options.node;
+  settings.detail = options.node.has_value();
   const auto update_size = [&] {
     settings.width = 132;
     settings.height = 50;
@@ -295,6 +361,11 @@ int RunTop(const TopOptions& options) {
       const ssize_t n = read(STDIN_FILENO, buffer, sizeof buffer);
       for (ssize_t i = 0; i < n; ++i)
         HandleKey(buffer[i], keys, settings, view);
+      // A terminal writes an escape sequence at once: a read that ends on a lone Esc was the key.
+      if (keys.escape == "\x1b") {
+        HandleEscape(keys.escape, settings, view);
+        keys.escape.clear();
+      }
       next_frame = std::chrono::steady_clock::now();  // redraw at once after a key
     }
   }

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -31,6 +32,8 @@ struct TopOptions {
   int height = 0;
   /// Interactive mode: turn to the next page every this many seconds (0 = only on `n`).
   std::chrono::seconds auto_page{0};
+  /// Open on this node's detail view (--node can0:6); --once prints it instead of the table.
+  std::optional<NodeKey> node{};
   std::ostream* out = nullptr;  ///< default std::cout
 };
 

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "tools/telemetry/event_format.hpp"
+#include "tools/telemetry/node_detail.hpp"
 
 namespace canfleet::tools {
 
@@ -112,6 +113,7 @@ constexpr const char* kRed = "\x1b[31m";
 constexpr const char* kYellow = "\x1b[33m";
 constexpr const char* kMagenta = "\x1b[35m";
 constexpr const char* kDim = "\x1b[2m";
+constexpr const char* kUnderline = "\x1b[4m";
 
 std::string Printf(const char* format, auto... args) {
   char text[512];
@@ -279,7 +281,26 @@ std::string FormatAge(std::chrono::system_clock::duration age) {
   return Printf("%.0fh", seconds / 3600);
 }
 
+std::optional<NodeKey> MoveSelection(const std::vector<const NodeRow*>& rows,
+                                     const std::optional<NodeKey>& current, int delta) {
+  if (rows.empty()) return std::nullopt;
+  const auto at = current ? std::find_if(rows.begin(), rows.end(),
+                                         [&](const NodeRow* r) { return r->status.key() == *current; })
+                          : rows.end();
+  if (at == rows.end()) return rows.front()->status.key();
+  const auto index =
+      std::clamp<std::ptrdiff_t>(at - rows.begin() + delta, 0, static_cast<std::ptrdiff_t>(rows.size()) - 1);
+  return rows[static_cast<std::size_t>(index)]->status.key();
+}
+
+std::optional<int> PageOf(const std::vector<const NodeRow*>& rows, const NodeKey& key, int rows_per_page) {
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (rows[i]->status.key() == key) return static_cast<int>(i) / std::max(1, rows_per_page);
+  return std::nullopt;
+}
+
 std::string RenderFrame(const FleetView& view, const RenderSettings& settings) {
+  if (settings.detail && settings.selected) return RenderNodeDetail(view, *settings.selected, settings);
   const WallTime now = settings.now;
   const auto rows = SelectRows(view, settings.filter, settings.sort, settings.reverse, now);
 
@@ -337,7 +358,12 @@ std::string RenderFrame(const FleetView& view, const RenderSettings& settings) {
   const std::size_t first = static_cast<std::size_t>(page) * static_cast<std::size_t>(per_page);
   for (std::size_t i = first; i < rows.size() && i < first + static_cast<std::size_t>(per_page); ++i) {
     const NodeRow& row = *rows[i];
-    std::string line = Fit(NodeLine(row, now), settings.width);
+    const bool selected = settings.selected == row.status.key();
+    // The selected row ends in "<" (plain) or is underlined (color); its start stays the bus name.
+    std::string line =
+        Fit(NodeLine(row, now), selected && !settings.color ? settings.width - 2 : settings.width);
+    if (selected && !settings.color) line += " <";
+    if (selected && settings.color) line = kUnderline + line + kReset;
     if (settings.color) {
       const bool changed = now - row.last_change < settings.highlight;
       const bool recent_emcy = row.last_emcy && now - row.last_emcy_time < settings.highlight;
@@ -380,10 +406,11 @@ std::string RenderFrame(const FleetView& view, const RenderSettings& settings) {
     }
     out += "\n";
   }
-  const std::string help =
-      settings.filter_prompt.empty()
-          ? "q quit  n/p page  s sort  r reverse  / filter  f faults only  a all  c clear"
-          : "filter: " + settings.filter_prompt + "_";
+  const std::string help = settings.filter_prompt.empty()
+                               ? "q quit  up/down select  Enter node detail  n/p page  s sort  r reverse  / "
+                                 "filter  f faults only  "
+                                 "a all  b bus  c clear"
+                               : "filter: " + settings.filter_prompt + "_";
   out += paint(kDim, Fit(help, settings.width)) + "\n";
   return out;
 }

@@ -46,14 +46,26 @@ struct RenderSettings {
   int event_lines = 5;                ///< recent events shown under the table
   std::string filter_prompt{};        ///< shown when the user is typing a filter
   WallTime now{};
+  /// The node the arrow keys selected (marked in the table); unset: none.
+  std::optional<NodeKey> selected{};
+  /// Show the selected node's detail screen instead of the table (Enter; Esc goes back).
+  bool detail = false;
 };
 
 /// Node rows that fit on one page of a screen of `height` lines with `bus_count` bus lines.
 int RowsPerPage(const RenderSettings& settings, int bus_count);
 int PageCount(std::size_t rows, int rows_per_page);
 
-/// The whole screen as text, lines separated by '\n', no cursor movement (the caller clears).
+/// The whole screen as text, lines separated by '\n', no cursor movement (the caller clears): the
+/// table, or with `detail` and a selected node that node's detail screen (RenderNodeDetail).
 std::string RenderFrame(const FleetView& view, const RenderSettings& settings);
+
+/// The row `delta` rows after (or before) `current` among `rows`, held at the ends; the first row
+/// when nothing is selected or the selected node is no longer shown; unset when `rows` is empty.
+std::optional<NodeKey> MoveSelection(const std::vector<const NodeRow*>& rows,
+                                     const std::optional<NodeKey>& current, int delta);
+/// The page (0-based) on which `key` is shown, if it is.
+std::optional<int> PageOf(const std::vector<const NodeRow*>& rows, const NodeKey& key, int rows_per_page);
 
 /// "1:02:03" or "3d04h".
 std::string FormatUptime(std::chrono::milliseconds uptime);

@@ -5,6 +5,8 @@
 // refused with file, line and field before anything starts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <csignal>
 #include <fstream>
 #include <sstream>
 
@@ -86,6 +88,59 @@ TEST(CanfleetTestCommandTest, ATypoInAnExpectationIsRefusedWithFileLineAndField)
   EXPECT_NE(out.find(file + ":9:"), std::string::npos) << out;
   EXPECT_NE(out.find("scenario[2].expect.nmt.state: \"preoperational\" is not a state"), std::string::npos)
       << out;
+}
+
+// `canfleet up` runs a scenario with scenario_repeat_ms again once it has ended: the same
+// labelled fault is injected and cleared in every run (the last run cleared it, so the next can
+// inject it again) and every run's expectations are judged and logged afresh.
+constexpr const char* kRepeating = R"(
+name: "repeating"
+scenario_repeat_ms: 500
+bus { name: "can0" bitrate: 250000 }
+node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" heartbeat { producer_ms: 200 } }
+node { name: "quad-6" device: "quad-controller" node_id: 6 bus: "can0"
+       heartbeat { producer_ms: 200 consumer { node: "quad-5" timeout_ms: 1000 } } }
+scenario { at_ms: 300 name: "cut-hb" inject { kind: HEARTBEAT_LOSS node: "quad-5" label: "hb" } }
+scenario { name: "emcy" expect { after: "cut-hb" within_ms: 4000 emcy { node: "quad-6" code: 0x8130 } } }
+scenario { at_ms: 3000 clear { label: "hb" } }
+scenario { at_ms: 3100 name: "start" nmt { action: NMT_START } }
+scenario { expect { after: "start" within_ms: 4000 nmt { node: "quad-6" state: "operational" } } }
+)";
+
+std::size_t Count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1))
+    ++n;
+  return n;
+}
+
+TEST(CanfleetUpScenarioTest, ARepeatingScenarioRunsAgainAndInjectsItsFaultsAgain) {
+  TempDir dir;
+  const std::string file = dir.File("repeating.textproto");
+  std::ofstream(file) << kRepeating;
+  ChildProcess up({PROGRAM_CANFLEET, "up", file, "--control", "tcp://127.0.0.1:0", "--listen",
+                   "tcp://127.0.0.1:0", "--node-binary", PROGRAM_CANFLEET_NODE},
+                  dir.File("stderr.log"));
+  // Two runs of about 4 s each on a real clock: a generous bound. The log is on stdout.
+  const auto third_run = up.WaitForLine(
+      [](const std::string& line) { return line.find("scenario run 3:") != std::string::npos; },
+      std::chrono::seconds(90));
+  // Runs 1 and 2: the lines before run 3 began (run 3 may already be judging).
+  std::vector<std::string> lines = up.Lines();
+  const auto run3 = std::find_if(lines.begin(), lines.end(), [](const std::string& line) {
+    return line.find("scenario run 3:") != std::string::npos;
+  });
+  lines.erase(run3, lines.end());
+  const std::string log = Joined(lines);
+  up.Signal(SIGTERM);
+  up.Wait(std::chrono::seconds(30));
+  ASSERT_TRUE(third_run) << log << up.Log();
+  EXPECT_NE(log.find("scenario run 2: 5 step(s), 2 expectation(s)"), std::string::npos) << log;
+  // Each run judged completely, on its own.
+  EXPECT_EQ(Count(log, "expect pass emcy: EMCY 8130h from quad-6"), 2u) << log;
+  EXPECT_EQ(Count(log, "expect pass scenario[4]: quad-6 operational"), 2u) << log;
+  EXPECT_EQ(Count(log, "expect fail"), 0u) << log;
+  EXPECT_EQ(log.find("already active"), std::string::npos) << log;
 }
 
 }  // namespace

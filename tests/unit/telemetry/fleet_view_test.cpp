@@ -146,6 +146,31 @@ TEST(FleetView, AnEmcyBeforeTheNodesFirstStatusIsKept) {
   EXPECT_EQ(row.last_emcy->emcy.code, 0x8120);
 }
 
+// The node detail view lists a node's EMCYs: every one the Emcy topic delivered (its history is
+// keep-last 32 per node), in time order whatever the arrival order, early ones included.
+TEST(FleetView, EachNodeKeepsItsEmcyHistoryInTimeOrderUpToTheTopicsDepth) {
+  FleetView view(kStart);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x8130}}, At(kStart + 2s), nullptr);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x8100}}, At(kStart + 1s), nullptr);
+  view.Apply(Status(6), At(kStart + 3s), nullptr);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x0000}}, At(kStart + 4s), nullptr);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 7, .emcy = {.code = 0x8140}}, At(kStart + 4s), nullptr);
+  const NodeRow& row = view.nodes().at({"can0", 6});
+  ASSERT_EQ(row.emcy_history.size(), 3u);
+  EXPECT_EQ(row.emcy_history[0].sample.emcy.code, 0x8100);
+  EXPECT_EQ(row.emcy_history[1].sample.emcy.code, 0x8130);
+  EXPECT_EQ(row.emcy_history[2].sample.emcy.code, 0x0000);
+  EXPECT_EQ(row.emcy_history[2].time, kStart + 4s);
+
+  for (int i = 0; i < 40; ++i)
+    view.Apply(
+        EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = static_cast<std::uint16_t>(0x1000 + i)}},
+        At(kStart + 10s + std::chrono::seconds(i)), nullptr);
+  const NodeRow& full = view.nodes().at({"can0", 6});
+  ASSERT_EQ(full.emcy_history.size(), kEmcyHistory);
+  EXPECT_EQ(full.emcy_history.back().sample.emcy.code, 0x1000 + 39);  // the oldest went first
+}
+
 TEST(FleetView, RecentEventsAreInTimeOrderWhateverTheArrivalOrder) {
   FleetView view(kStart);
   view.Apply(FaultEventSample{.bus = "can0", .fault_id = 1}, At(kStart + 2s), nullptr);

@@ -1,6 +1,8 @@
 // `canfleet top`: row selection, ordering, paging and the rendered screen.
 #include "tools/telemetry/top_format.hpp"
 
+#include "tools/telemetry/node_detail.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -128,6 +130,125 @@ TEST_F(TopFormat, ColorFrameMarksFaultsRedAndFreshChangesReversed) {
   });
   ASSERT_NE(quiet, lines.end());
   EXPECT_EQ(quiet->find('\x1b'), std::string::npos);  // healthy and quiet: plain
+}
+
+TEST_F(TopFormat, ArrowKeysMoveTheSelectionWithinTheShownRowsAndItIsMarked) {
+  const auto rows = SelectRows(view_, {}, SortKey::kBusNode, false, kNow);  // 1, 3, 4 on can0; 2 on can1
+  auto selected = MoveSelection(rows, std::nullopt, +1);                    // nothing yet: the first
+  ASSERT_TRUE(selected);
+  EXPECT_EQ(selected->node_id, 1);
+  selected = MoveSelection(rows, selected, +1);
+  EXPECT_EQ(selected->node_id, 3);
+  EXPECT_EQ(MoveSelection(rows, selected, -5)->node_id, 1);            // held at the top
+  EXPECT_EQ(MoveSelection(rows, selected, +10)->node_id, 2);           // and at the bottom
+  EXPECT_EQ(MoveSelection(rows, NodeKey{"can9", 1}, +1)->node_id, 1);  // filtered out: the first
+  EXPECT_FALSE(MoveSelection({}, selected, +1));
+  EXPECT_EQ(PageOf(rows, {"can1", 2}, 2), 1);
+  EXPECT_FALSE(PageOf(rows, {"can9", 1}, 2));
+
+  RenderSettings settings{.color = false, .now = kNow, .selected = NodeKey{"can0", 3}};
+  const auto lines = Lines(RenderFrame(view_, settings));
+  const auto marked = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.size() > 2 && l.compare(l.size() - 2, 2, " <") == 0;
+  });
+  EXPECT_EQ(marked, 1);
+  const auto row = std::find_if(lines.begin(), lines.end(),
+                                [](const std::string& l) { return l.rfind("can0       3", 0) == 0; });
+  ASSERT_NE(row, lines.end());
+  EXPECT_EQ(row->substr(row->size() - 2), " <");
+  EXPECT_NE(lines.back().find("Enter node detail"), std::string::npos);  // the help line says how
+}
+
+class NodeDetail : public TopFormat {
+ protected:
+  void SetUp() override {
+    TopFormat::SetUp();
+    NodeStatusSample s = Status("can0", 6);
+    s.device = "quad-controller";
+    s.error_register = 0x01;
+    s.heartbeat_producer_ms = 500;
+    s.heartbeat_consumers = {{.node_id = 5,
+                              .time_ms = 1500,
+                              .state = telemetry::HeartbeatConsumerState::kTimedOut,
+                              .last_state = NmtState::kOperational}};
+    s.rpdo_count = 378;
+    s.tpdo_count = 1512;
+    view_.Apply(s, At(kNow - 500ms), nullptr);
+    IoSnapshotSample io{.bus = "can0", .node_id = 6};
+    io.inputs = {{"AIN1.voltage_mV", 1200, "mV"}, {"DIN1.level", 1, ""}};
+    io.outputs = {
+        {"POUT1.current_mA", 0, "mA"}, {"VPS.voltage_V", 4.75, "V"}, {"POUT2.current_mA", 800, "mA"}};
+    view_.Apply(io, At(kNow - 400ms), nullptr);
+    view_.Apply(EmcySample{.bus = "can0",
+                           .node_id = 6,
+                           .emcy = {.code = 0x8130, .error_register = 0x01, .manufacturer = {5, 8, 0, 0, 0}}},
+                At(kNow - 2s), nullptr);
+    view_.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x0000}}, At(kNow - 60s), nullptr);
+  }
+  RenderSettings settings_{.color = false, .now = kNow, .selected = NodeKey{"can0", 6}, .detail = true};
+};
+
+TEST_F(NodeDetail, ShowsStatusCountersIoWithUnitsAndTheEmcysTheBusSawNewestFirst) {
+  const std::string frame = RenderFrame(view_, settings_);
+  EXPECT_EQ(frame.find('\x1b'), std::string::npos);
+  EXPECT_NE(frame.find("can0 #6  quad-controller"), std::string::npos);
+  EXPECT_NE(frame.find("error register (1001h) 01h"), std::string::npos);
+  EXPECT_NE(frame.find("#5 timed-out (1500 ms, last OPER)"), std::string::npos);
+  EXPECT_NE(frame.find("378 RPDOs received, 1512 TPDOs sent"), std::string::npos);
+  EXPECT_NE(frame.find("SIMULATED INPUTS (2)"), std::string::npos);
+  EXPECT_NE(frame.find("SIMULATED OUTPUTS (3)"), std::string::npos);
+  const auto lines = Lines(frame);
+  const auto ain = std::find_if(lines.begin(), lines.end(),
+                                [](const std::string& l) { return l.rfind("AIN1.voltage_mV", 0) == 0; });
+  ASSERT_NE(ain, lines.end());
+  EXPECT_NE(ain->find("1200 mV"), std::string::npos);
+  EXPECT_NE(ain->find("POUT1.current_mA"), std::string::npos);  // outputs beside the inputs
+  EXPECT_NE(ain->find("0 mA"), std::string::npos);
+  EXPECT_NE(frame.find("4.75 V"), std::string::npos);
+  EXPECT_NE(frame.find("AS THE BUS SAW THEM"), std::string::npos);
+  const auto heartbeat = frame.find("8130h  01h  05 08 00 00 00  ");
+  const auto reset = frame.find("0000h  00h  00 00 00 00 00  ");
+  ASSERT_NE(heartbeat, std::string::npos);
+  ASSERT_NE(reset, std::string::npos);
+  EXPECT_LT(heartbeat, reset);  // newest first
+  // 1003h is not telemetry: the screen says where to read it instead of showing a guess.
+  EXPECT_NE(frame.find("canfleet sdo read NODE 0x1003 1 u32"), std::string::npos);
+  EXPECT_NE(lines.back().find("Esc back"), std::string::npos);
+}
+
+TEST_F(NodeDetail, FitsTheScreenAndKeepsTheNewestEmcysWhenShort) {
+  for (int i = 0; i < 20; ++i)
+    view_.Apply(
+        EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = static_cast<std::uint16_t>(0x2300 + i)}},
+        At(kNow - 1s + std::chrono::milliseconds(i)), nullptr);
+  settings_.width = 60;
+  settings_.height = 20;
+  const auto lines = Lines(RenderFrame(view_, settings_));
+  EXPECT_LE(static_cast<int>(lines.size()), settings_.height);
+  for (const auto& line : lines)
+    EXPECT_LE(static_cast<int>(line.size()), settings_.width);
+  const std::string frame = RenderFrame(view_, settings_);
+  EXPECT_NE(frame.find("2313h"), std::string::npos);  // the newest is shown
+  EXPECT_EQ(frame.find("0000h"), std::string::npos);  // the oldest gave way
+}
+
+TEST_F(NodeDetail, AnUnknownNodeOrNoIoSaysSo) {
+  settings_.selected = NodeKey{"can7", 9};
+  EXPECT_NE(RenderFrame(view_, settings_).find("no telemetry of can7 #9"), std::string::npos);
+  settings_.selected = NodeKey{"can0", 3};  // a status, no IoSnapshot
+  EXPECT_NE(RenderFrame(view_, settings_).find("simulated I/O: none published"), std::string::npos);
+  EXPECT_NE(RenderFrame(view_, settings_).find("(none since the Emcy topic's history began)"),
+            std::string::npos);
+  settings_.detail = false;  // back: the table
+  EXPECT_NE(RenderFrame(view_, settings_).find("LAST EMCY"), std::string::npos);
+}
+
+TEST(TopText, IoValuesAreShortAndExact) {
+  EXPECT_EQ(FormatIoValue(1200), "1200");
+  EXPECT_EQ(FormatIoValue(-40), "-40");
+  EXPECT_EQ(FormatIoValue(23.5), "23.5");
+  EXPECT_EQ(FormatIoValue(4.75), "4.75");
+  EXPECT_EQ(FormatIoValue(0.1234), "0.123");
 }
 
 TEST(TopPaging, A127NodeBusPagesWithinTheScreen) {

@@ -504,6 +504,26 @@ TEST(TopologyScenarioTest, LabelsAreUniqueAndClearedOnlyAfterTheirInjection) {
   EXPECT_NO_THROW(ParseTopology(kTwoQuads + "scenario { clear { } }", kFile));  // clears every fault
 }
 
+// A repeating scenario's next run injects its labels again: it must have clear()ed them.
+TEST(TopologyScenarioTest, ARepeatingScenarioClearsWhatItInjects) {
+  const std::string inject =
+      "scenario { at_ms: 1000 inject { kind: HEARTBEAT_LOSS node: \"quad-5\" label: \"hb\" } }\n";
+  const std::string repeat = "scenario_repeat_ms: 5000\n";
+  EXPECT_NO_THROW(
+      ParseTopology(kTwoQuads + repeat + inject + "scenario { at_ms: 2000 clear { label: \"hb\" } }", kFile));
+  EXPECT_NO_THROW(ParseTopology(kTwoQuads + repeat + inject + "scenario { at_ms: 2000 clear { } }", kFile));
+  // A bus-off that recovers on its own ends by itself (one-shot): nothing to clear.
+  EXPECT_NO_THROW(ParseTopology(
+      kTwoQuads + repeat + "scenario { inject { kind: BUS_OFF node: \"quad-5\" label: \"off\" } }", kFile));
+  EXPECT_THAT(
+      Refusal(kTwoQuads + repeat + inject).what(),
+      HasSubstr("scenario[0].inject.label: the scenario repeats (scenario_repeat_ms) but never clears "
+                "\"hb\""));
+  EXPECT_THAT(Refusal(kTwoQuads + repeat).what(),
+              HasSubstr("scenario_repeat_ms: there is no scenario to repeat"));
+  EXPECT_NO_THROW(ParseTopology(kTwoQuads + inject, kFile));  // once: a fault may stay
+}
+
 TEST(TopologyScenarioTest, ProcessFaultsCannotReachExternalNodes) {
   const TopologyError e = Refusal(R"(name: "t" bus { name: "can0" }
 node { name: "x" device: "quad-controller" node_id: 5 bus: "can0" external: true }
