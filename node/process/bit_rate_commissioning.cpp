@@ -53,4 +53,18 @@ void CommissionBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
   if (!c.message.empty() && log) log("port " + std::to_string(p + 1) + ": " + c.message);
 }
 
+void KeepFactoryBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
+                        const std::function<void(const std::string&)>& log) {
+  auto* client = dynamic_cast<BrokerClientPort*>(&port);
+  if (client == nullptr || client->BitRate() != 0) return;
+  const auto kbit = canopen::BitRateKbit(node.stack(p).BitTimingIndex());
+  if (!kbit) return;
+  client->SetBitRate(*kbit * 1000);
+  const auto session = client->Session();
+  if (log && session && session->bitrate != *kbit * 1000)
+    log("port " + std::to_string(p + 1) + ": factory bit rate " + std::to_string(*kbit) +
+        " kbit/s kept on a bus at " + std::to_string(session->bitrate / 1000) +
+        " kbit/s: no traffic until a master sets the rate");
+}
+
 }  // namespace canfleet::node

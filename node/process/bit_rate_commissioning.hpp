@@ -36,4 +36,11 @@ Commissioning CommissionFor(std::uint32_t stated, std::uint32_t bus_bitrate, std
 void CommissionBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
                        const std::function<void(const std::string&)>& log);
 
+/// --factory-bit-rate: for a broker port whose controller states no rate yet, states the stack's
+/// own rate (its stored LSS configuration or the manual's factory rate), so a factory-new device on
+/// a bus at another rate sees error frames and no traffic until a master sets its rate by LSS or
+/// its bit-rate object. Other ports (SocketCAN) are left alone.
+void KeepFactoryBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
+                        const std::function<void(const std::string&)>& log);
+
 }  // namespace canfleet::node

@@ -115,9 +115,13 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   std::vector<std::unique_ptr<BusPort>> ports;
   auto start_when_all_connected = [&] {
     if (++connected_ports == port_count) {
-      for (std::size_t p = 0; p < port_count; ++p)
-        node::CommissionBitRate(*node, p, *ports[p],
-                                [&log](const std::string& line) { log->info("{}", line); });
+      for (std::size_t p = 0; p < port_count; ++p) {
+        const auto log_line = [&log](const std::string& line) { log->info("{}", line); };
+        if (options.factory_bit_rate)
+          node::KeepFactoryBitRate(*node, p, *ports[p], log_line);
+        else
+          node::CommissionBitRate(*node, p, *ports[p], log_line);
+      }
       node->Start();
       log->info("powered on");
       node::ReleaseFreedHeap();  // what loading the stored parameters freed
@@ -223,6 +227,9 @@ int main(int argc, char** argv) {
   auto* serial_opt = app.add_option("--serial", serial, "serial number (1018h sub 4)");
   app.add_option("--name", options.name, "name in logs and on the broker (default DEVICE@ID)");
   app.add_option("--io", options.io, "initial simulated input NAME=VALUE (repeatable)");
+  app.add_flag("--factory-bit-rate", options.factory_bit_rate,
+               "a port with no bit rate configured (LSS, 5B50h) runs at the variant's factory rate, as a "
+               "factory-new device plugged into the bus (default: commissioned for its bus's rate)");
   app.add_flag("--stdin-control", options.stdin_control,
                "accept set/get/list/nmt commands on standard input");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")

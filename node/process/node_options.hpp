@@ -26,6 +26,9 @@ struct NodeOptions {
   std::string name;             ///< --name (log prefix, broker port name)
   std::vector<std::string> io;  ///< --io NAME=VALUE initial simulated inputs
   bool stdin_control = false;   ///< --stdin-control
+  /// --factory-bit-rate: a port with no rate configured runs at the manual's factory rate rather
+  /// than being commissioned for its bus (node/process/bit_rate_commissioning.hpp).
+  bool factory_bit_rate = false;
   std::string log_level = "info";
 };
 

@@ -221,5 +221,28 @@ TEST_F(CanfleetNodeBitRate, AStored5B50hTakesEffectAtResetAndSurvivesAPowerCycle
   EXPECT_EQ(master.ReadUnsigned(kB, 0x5B50, 0), 2u);
 }
 
+// --factory-bit-rate: a factory-new node C (node-ID 7, nothing configured) keeps the manual's
+// factory 125 kbit/s (UMAX020411A §3.1, 5B50h default 4, Table 32) on the 500 kbit/s bus: its
+// boot-up and heartbeats are destroyed (error frames on 707h, never a valid one) until a master
+// meets it at its rate, which reads its 5B50h there.
+TEST_F(CanfleetNodeBitRate, AFactoryNewNodeOnABusAtAnotherRateIsCutOffUntilAMasterMeetsItsRate) {
+  std::size_t from = master.Frames().size();
+  auto args = ValveArgs(7, broker.endpoint(), dir.File("state-c"));
+  args.push_back("--factory-bit-rate");
+  NodeProcess c(dir, "c", args);
+  EXPECT_TRUE(master.RunUntil([&] {
+    return AnyLine(c, "factory bit rate 125 kbit/s kept on a bus at 500 kbit/s");
+  })) << c.Output();
+  EXPECT_TRUE(
+      master.WaitForFrame([](const SeenFrame& f) { return f.frame.error() && f.frame.id == 0x707; }, from))
+      << c.Output();
+  EXPECT_FALSE(master.WaitForFrame("707#00", from, 1s));
+  // A master at 125 kbit/s reaches it: 5B50h reads the factory index 4.
+  MasterAt(125'000);
+  EXPECT_EQ(master.ReadUnsigned(7, 0x5B50, 0), 4u);
+  MasterAt(0);
+  EXPECT_TRUE(c.process().Running()) << c.Output();
+}
+
 }  // namespace
 }  // namespace canfleet::system_test
