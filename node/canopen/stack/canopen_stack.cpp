@@ -64,7 +64,7 @@ CanopenStack::CanopenStack(ObjectDictionary& od, BusPort& port, Scheduler& sched
   // Only CiA 305 table-0 indexes are bit rates (UMAX020411A Table 32: 5 is reserved).
   if (options_.bit_rate_object) {
     if (SubObject* sub = od_.Find(options_.bit_rate_object->index, options_.bit_rate_object->sub_index)) {
-      sub->validators.push_back([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
+      sub->AddValidator([](const SubObject&, std::span<const std::uint8_t> data, Origin) {
         const std::uint64_t value = DecodeUnsignedLe(data);
         return value <= 0xFF && BitRateKbit(static_cast<std::uint8_t>(value)) ? SdoAbort::kNone
                                                                               : SdoAbort::kInvalidValue;
