@@ -1,43 +1,32 @@
 #include "tests/unit/devices/quad_fixture.hpp"
 
-#include <cstdio>
+#include "tests/support/sdo_script.hpp"
 
 namespace canfleet::devices::test {
 
-std::string LeHex(std::uint64_t value, int size) {
-  std::string out;
-  char buf[4];
-  for (int i = 0; i < size; ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", static_cast<unsigned>((value >> (8 * i)) & 0xFF));
-    out += buf;
-  }
-  return out;
-}
-
 namespace {
-
-std::string Multiplexer(std::uint16_t index, std::uint8_t sub) {
-  return LeHex(index, 2) + LeHex(sub, 1);
-}
-
+/// QuadTest::kNodeId, for the free functions below (the constant is the fixture's, protected).
+constexpr std::uint8_t kNode = 5;
 }  // namespace
 
+std::string LeHex(std::uint64_t value, int size) {
+  return canfleet::test::LeHex(value, size);
+}
+
 std::string SdoWrite(std::uint16_t index, std::uint8_t sub, std::uint64_t value, int size) {
-  static const char* kCommand[] = {"", "2F", "2B", "27", "23"};
-  return std::string("605#") + kCommand[size] + Multiplexer(index, sub) + LeHex(value, size) +
-         std::string(static_cast<std::size_t>(2 * (4 - size)), '0');
+  return canfleet::test::SdoDownload(kNode, index, sub, value, size);
 }
 
 std::string SdoWritten(std::uint16_t index, std::uint8_t sub) {
-  return "585#60" + Multiplexer(index, sub) + "00000000";
+  return canfleet::test::SdoDownloaded(kNode, index, sub);
 }
 
 std::string SdoAborted(std::uint16_t index, std::uint8_t sub, std::uint32_t code) {
-  return "585#80" + Multiplexer(index, sub) + LeHex(code, 4);
+  return canfleet::test::SdoAbortFrom(kNode, index, sub, code);
 }
 
 std::string SdoRead(std::uint16_t index, std::uint8_t sub) {
-  return "605#40" + Multiplexer(index, sub) + "00000000";
+  return canfleet::test::SdoUpload(kNode, index, sub);
 }
 
 std::string Emcy(std::uint16_t code, std::uint8_t reg, std::uint8_t channel, std::uint8_t description) {
@@ -59,33 +48,15 @@ void QuadTest::Start() {
 }
 
 std::vector<std::string> QuadTest::Frames() {
-  std::vector<std::string> out(backlog_.begin(), backlog_.end());
-  backlog_.clear();
-  for (auto& f : master_.Take())
-    out.push_back(std::move(f));
-  return out;
+  return canfleet::test::TakeFrames(master_, backlog_);
 }
 
 std::vector<std::string> QuadTest::Frames(std::string_view prefix) {
-  std::vector<std::string> out;
-  for (auto& f : Frames()) {
-    if (f.starts_with(prefix)) out.push_back(std::move(f));
-  }
-  return out;
+  return canfleet::test::TakeFrames(master_, backlog_, prefix);
 }
 
 std::string QuadTest::Sdo(std::string_view request) {
-  for (auto& f : master_.Take())
-    backlog_.push_back(std::move(f));
-  master_.Send(request);
-  std::string answer;
-  for (auto& f : master_.Take()) {
-    if (answer.empty() && f.starts_with("585#"))
-      answer = std::move(f);
-    else
-      backlog_.push_back(std::move(f));
-  }
-  return answer;
+  return canfleet::test::ExchangeSdo(master_, backlog_, kNodeId, request);
 }
 
 std::string QuadTest::TryWrite(std::uint16_t index, std::uint8_t sub, std::uint64_t value, int size) {
@@ -97,19 +68,7 @@ void QuadTest::Write(std::uint16_t index, std::uint8_t sub, std::uint64_t value,
 }
 
 std::int64_t QuadTest::Read(std::uint16_t index, std::uint8_t sub, bool is_signed) {
-  std::string answer = Sdo(SdoRead(index, sub));
-  // "585#4Bxxxxss" + data: 4F 1 byte, 4B 2, 47 3, 43 4.
-  EXPECT_EQ(answer.size(), 4u + 16u) << answer;
-  if (answer.size() != 20) return 0;
-  const std::string cmd = answer.substr(4, 2);
-  int size = cmd == "4F" ? 1 : cmd == "4B" ? 2 : cmd == "47" ? 3 : cmd == "43" ? 4 : 0;
-  EXPECT_NE(size, 0) << answer;
-  std::uint64_t value = 0;
-  for (int i = 0; i < size; ++i)
-    value |= std::stoull(answer.substr(static_cast<std::size_t>(12 + 2 * i), 2), nullptr, 16) << (8 * i);
-  if (is_signed && size > 0 && size < 8 && ((value >> (8 * size - 1)) & 1))
-    value |= ~std::uint64_t{0} << (8 * size);
-  return static_cast<std::int64_t>(value);
+  return canfleet::test::ExpeditedValue(Sdo(SdoRead(index, sub)), is_signed);
 }
 
 void QuadTest::SilenceTpdoTimers() {
