@@ -64,10 +64,8 @@ class FleetEncoderTest : public ProductFleetTest {
 TEST_F(FleetEncoderTest, HeartbeatLossRaises80nn8130hAndReactsPer1029h) {
   ASSERT_TRUE(Cli({"fault", "inject", "heartbeat-loss", "--node", "quad-5"}));
   for (const char* encoder : {"encoder-a", "encoder-b"}) {
-    EXPECT_TRUE(WaitLog(EmcyLine(encoder, 0x8130, 0x01, "05 80 00 00 00"))) << fleet().Log();
+    ExpectErrorRecorded(encoder, 0x8130, "05 80 00 00 00", 0x80058130u);
     EXPECT_TRUE(WaitUntil([&] { return LastEmcyOf(encoder) == 0x8130u; }, kProductPatience)) << encoder;
-    EXPECT_EQ(Sdo(encoder, "0x1003", 1, "u32"), 0x80058130u) << encoder;
-    EXPECT_EQ(Sdo(encoder, "0x1001", 0, "u8"), 0x01u) << encoder;
   }
   // C3-1.2.11: encoder-b (1029h.1 = 0) pre-operational, where its CAN-controlled OUT1 is off
   // (choice 7); encoder-a (default 1) stays operational and keeps driving OUT1.
@@ -91,9 +89,7 @@ TEST_F(FleetEncoderTest, RpdoTimeoutRaises00008100hAndShutsTheControlledOutputOf
   ASSERT_TRUE(Cli({"fault", "inject", "rpdo-timeout", "--node", "encoder-a", "--cob-id", "0x185"}));
   ASSERT_TRUE(Cli({"fault", "inject", "rpdo-timeout", "--node", "encoder-b", "--cob-id", "0x185"}));
   for (const char* encoder : {"encoder-a", "encoder-b"}) {
-    EXPECT_TRUE(WaitLog(EmcyLine(encoder, 0x8100, 0x01, "00 00 00 00 00"))) << fleet().Log();
-    EXPECT_EQ(Sdo(encoder, "0x1003", 1, "u32"), 0x00008100u) << encoder;
-    EXPECT_EQ(Sdo(encoder, "0x1001", 0, "u8"), 0x01u) << encoder;
+    ExpectErrorRecorded(encoder, 0x8100, "00 00 00 00 00", 0x00008100u);
     // Table 12: 6340h = 0 (default) shuts OUT1 off while 7300h.1 is in error.
     EXPECT_TRUE(WaitIo(encoder, kOut1, 0)) << encoder << ": " << IoText(encoder, kOut1);
   }

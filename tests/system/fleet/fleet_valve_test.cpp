@@ -60,10 +60,8 @@ TEST_F(FleetValveTest, HeartbeatLossRaises80nn8130hAndReactsPer1029h) {
   ASSERT_TRUE(Cli({"fault", "inject", "heartbeat-loss", "--node", "quad-5"}));
   // Table 33: 80058130h, EMCY 8130h with channel 05h (the silent node), description 80h.
   for (const char* valve : {"valve-a", "valve-b"}) {
-    EXPECT_TRUE(WaitLog(EmcyLine(valve, 0x8130, 0x01, "05 80 00 00 00"))) << fleet().Log();
+    ExpectErrorRecorded(valve, 0x8130, "05 80 00 00 00", 0x80058130u);
     EXPECT_TRUE(WaitUntil([&] { return LastEmcyOf(valve) == 0x8130u; }, kProductPatience)) << valve;
-    EXPECT_EQ(Sdo(valve, "0x1003", 1, "u32"), 0x80058130u) << valve;
-    EXPECT_EQ(Sdo(valve, "0x1001", 0, "u8"), 0x01u) << valve;
   }
   // §3.2.13: valve-b (1029h.1 = 0) goes pre-operational; valve-a (default 1) stays operational.
   EXPECT_TRUE(WaitNmt("valve-b", "pre-operational"));
@@ -90,9 +88,7 @@ TEST_F(FleetValveTest, RpdoTimeoutRaises00008100hAndDrivesOutputsToTheirFaultVal
   ASSERT_TRUE(Cli({"fault", "inject", "rpdo-timeout", "--node", "valve-a", "--cob-id", "0x185"}));
   ASSERT_TRUE(Cli({"fault", "inject", "rpdo-timeout", "--node", "valve-b", "--cob-id", "0x185"}));
   for (const char* valve : {"valve-a", "valve-b"}) {
-    EXPECT_TRUE(WaitLog(EmcyLine(valve, 0x8100, 0x01, "00 00 00 00 00"))) << fleet().Log();
-    EXPECT_EQ(Sdo(valve, "0x1003", 1, "u32"), 0x00008100u) << valve;
-    EXPECT_EQ(Sdo(valve, "0x1001", 0, "u8"), 0x01u) << valve;
+    ExpectErrorRecorded(valve, 0x8100, "00 00 00 00 00", 0x00008100u);
     // Choice 5, §3.3.22/§3.3.29: 6340h = 1 applies 7341h = 500 mA while the RPDO is timed out.
     EXPECT_TRUE(WaitIo(valve, kOut1, 500)) << valve << ": " << IoText(valve, kOut1);
   }

@@ -81,6 +81,13 @@ double ProductFleetTest::IoNumber(const std::string& node, const std::string& na
   }
 }
 
+void ProductFleetTest::ExpectErrorRecorded(const std::string& node, std::uint16_t code,
+                                           const std::string& data, std::uint32_t entry) {
+  EXPECT_TRUE(WaitLog(EmcyLine(node, code, 0x01, data))) << fleet().Log();
+  EXPECT_EQ(Sdo(node, "0x1003", 1, "u32"), entry) << node;
+  EXPECT_EQ(Sdo(node, "0x1001", 0, "u8"), 0x01u) << node;
+}
+
 std::string ProductFleetTest::IoText(const std::string& node, const std::string& name) const {
   return fleet_->IoGet(node, name).value_or("");
 }

@@ -55,6 +55,11 @@ class ProductFleetTest : public ::testing::Test {
   /// The orchestrator's EMCY log line for `node` (fleet.cpp): code, error register, 5 data bytes.
   static std::string EmcyLine(const std::string& node, std::uint16_t code, std::uint8_t reg,
                               const std::string& data);
+  /// The family's record of a communication error on `node` (family_error_policy.hpp): the
+  /// orchestrator logged its EMCY `code` with 1001h = 01h and the manufacturer bytes `data`, 1003h
+  /// sub 1 holds `entry` and 1001h reads 01h.
+  void ExpectErrorRecorded(const std::string& node, std::uint16_t code, const std::string& data,
+                           std::uint32_t entry);
   /// SDO upload through the orchestrator; nullopt (with a test failure) when it aborts.
   std::optional<std::uint64_t> Sdo(const std::string& node, const std::string& index, int sub,
                                    const std::string& type) const;
