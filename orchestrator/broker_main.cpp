@@ -15,6 +15,7 @@
 #include <charconv>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -104,8 +105,28 @@ int main(int argc, char** argv) {
                  "How often BusStats are sampled and republished, seconds")
       ->check(CLI::Range(0.05, 3600.0))
       ->capture_default_str();
+  std::string time_mode = "real";
+  std::string speed = "max";
+  std::size_t wait_nodes = 0;
+  app.add_option("--time", time_mode,
+                 "real, or virtual: lock-step virtual time, the broker owns the clock and nodes join with "
+                 "canfleet-node --time virtual (orchestrator/broker/README.md, \"Virtual time\")")
+      ->check(CLI::IsMember({"real", "virtual"}))
+      ->capture_default_str();
+  app.add_option("--speed", speed, "Virtual time: max, or simulated seconds per real second (e.g. 10)")
+      ->capture_default_str();
+  app.add_option("--wait-nodes", wait_nodes,
+                 "Virtual time: time starts once this many node processes have joined (or after 60 s)");
   canfleet::telemetry::AddDdsOptions(app, dds, canfleet::telemetry::DdsDiscovery::kMonitorsOnly);
   CLI11_PARSE(app, argc, argv);
+  canfleet::host::HostTime time;
+  time.virtual_time = time_mode == "virtual";
+  try {
+    time.conductor.speed = canfleet::host::ParseSpeed(speed);
+  } catch (const std::exception& e) {
+    std::cerr << "canfleet-broker: " << e.what() << "\n";
+    return 2;
+  }
 
   spdlog::set_default_logger(spdlog::stderr_color_mt("canfleet-broker"));
   spdlog::set_level(spdlog::level::from_str(log_level));
@@ -119,7 +140,12 @@ int main(int argc, char** argv) {
     listens.push_back("tcp://127.0.0.1:" + std::to_string(canfleet::wire::kDefaultBrokerPort));
 
   asio::io_context io(1);
-  canfleet::host::BrokerHost host(io);
+  canfleet::host::BrokerHost host(io, {}, time);
+  if (auto* conductor = host.conductor()) {
+    spdlog::info("virtual time ({}): nodes must join with --time virtual",
+                 time.conductor.speed > 0 ? "paced at " + speed + "x" : std::string("as fast as possible"));
+    conductor->HoldUntilJoined(wait_nodes, canfleet::host::kJoinTimeout);
+  }
   try {
     for (const auto& spec : bus_specs)
       host.AddBus(ParseBus(spec));

@@ -39,7 +39,7 @@ long long Ms(std::chrono::milliseconds d) {
 /// keeps it alive ([this, self] captures, style.md "Asio lifetimes"); the port only points to it
 /// and detaches itself (owner_ = nullptr) when destroyed. Each connection attempt has a
 /// generation number: completions of an older socket are ignored.
-class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
+class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public GrantedPort {
  public:
   Link(asio::io_context& io, BrokerClientPort& owner, BrokerClientOptions options)
       : io_(io),
@@ -56,6 +56,8 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
   }
 
   void Shutdown() {
+    if (phase_ == Phase::kConnected && options_.virtual_time)
+      options_.virtual_time->Disconnected(options_.virtual_time_index);
     owner_ = nullptr;
     phase_ = Phase::kStopped;
     ++generation_;
@@ -70,7 +72,10 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       ++stats_.tx_refused;
       return false;
     }
-    filling_.AddFrame(frame);
+    // In virtual time a frame carries the time it was sent: the broker puts it on the bus then.
+    filling_.AddFrame(frame, options_.virtual_time
+                                 ? options_.virtual_time->scheduler().Now().time_since_epoch()
+                                 : BusTime::zero());
     ++stats_.tx_frames;
     ScheduleFlush();
     return true;
@@ -155,6 +160,11 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
                                         options_.monitor ? wire::ROLE_MONITOR : wire::ROLE_NODE);
     hello.set_tx_confirmations(options_.tx_confirmations);
     hello.set_bitrate(options_.bitrate);
+    if (options_.virtual_time) {
+      hello.set_virtual_time(true);
+      hello.set_clock_id(options_.virtual_time->clock_id());
+      hello.set_clock_ports(static_cast<std::uint32_t>(options_.virtual_time->port_count()));
+    }
     filling_.AddHello(hello);
     const std::uint64_t gen = generation_;
     Flush();
@@ -230,6 +240,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       }
       return;
     }
+    if (options_.virtual_time && Hold(m)) return;
     switch (m.type) {
       case wire::MessageType::kFrames:
         stats_.rx_frames += m.frames.size();
@@ -263,13 +274,89 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       case wire::MessageType::kNodeRequest:
         OnNodeRequest(m.envelope.node_request());
         return;
+      case wire::MessageType::kTimeGrant:
+        if (!options_.virtual_time) {
+          ProtocolError("TimeGrant on a connection in real time");
+          return;
+        }
+        options_.virtual_time->Granted(options_.virtual_time_index,
+                                       TimePoint(Duration(m.envelope.time_grant().now_ns())),
+                                       TimePoint(Duration(m.envelope.time_grant().until_ns())));
+        return;
       case wire::MessageType::kHello:
       case wire::MessageType::kHelloReply:
       case wire::MessageType::kNodeReply:
       case wire::MessageType::kBitRate:
+      case wire::MessageType::kTimeReached:
         ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from the broker");
         return;
     }
+  }
+
+  /// Virtual time: what happens at the next grant's time is held until that grant. True when `m`
+  /// was held.
+  bool Hold(const wire::Message& m) {
+    switch (m.type) {
+      case wire::MessageType::kFrames:
+      case wire::MessageType::kTxConfirm:
+        for (std::size_t i = 0; i < m.frames.size(); ++i)
+          held_.push_back({m.type, m.frames[i], {}, 0});
+        return true;
+      case wire::MessageType::kControllerEvent:
+        held_.push_back({m.type, {}, m.controller, 0});
+        return true;
+      case wire::MessageType::kNodeRequest:
+        held_requests_.push_back(m.envelope.node_request());
+        held_.push_back({m.type, {}, {}, held_requests_.size() - 1});
+        return true;
+      default:
+        return false;
+    }
+  }
+
+  void ApplyHeld() override {
+    const std::uint64_t gen = generation_;
+    // Swapped out: applying may hold nothing new (no reads happen meanwhile), but a handler may
+    // destroy the port.
+    std::vector<Held> items;
+    items.swap(held_);
+    std::vector<wire::NodeRequest> requests;
+    requests.swap(held_requests_);
+    for (const Held& item : items) {
+      if (gen != generation_ || owner_ == nullptr) return;
+      switch (item.type) {
+        case wire::MessageType::kFrames:
+          ++stats_.rx_frames;
+          if (item.frame.frame.error()) OnErrorFrame(item.frame.frame);
+          owner_->Deliver(item.frame.frame, item.frame.time);
+          break;
+        case wire::MessageType::kTxConfirm:
+          if (on_tx_confirmed) on_tx_confirmed(item.frame.frame, item.frame.time);
+          break;
+        case wire::MessageType::kControllerEvent:
+          state_ = item.controller.state;
+          owner_->NotifyState(item.controller);
+          break;
+        case wire::MessageType::kNodeRequest:
+          OnNodeRequest(requests[item.request]);
+          break;
+        default:
+          break;
+      }
+    }
+    if (gen != generation_) return;
+    items.clear();
+    requests.clear();
+    if (held_.empty()) held_.swap(items);  // keep the storage
+    if (held_requests_.empty()) held_requests_.swap(requests);
+  }
+
+  void Reached(TimePoint time, std::optional<TimePoint> next_deadline) override {
+    if (phase_ != Phase::kConnected) return;
+    filling_.AddTimeReached(
+        time.time_since_epoch().count(),
+        next_deadline ? std::optional(next_deadline->time_since_epoch().count()) : std::nullopt);
+    ScheduleFlush();
   }
 
   /// Counts error frames; the first one after a connection or a rate change is logged, with the
@@ -317,10 +404,28 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
       if (on_connection) on_connection(false, detail);
       return;
     }
+    if (reply.virtual_time() != (options_.virtual_time != nullptr)) {
+      const std::string detail = std::string("refused: the bus runs in ") +
+                                 (reply.virtual_time() ? "virtual" : "real") + " time, this node in " +
+                                 (options_.virtual_time ? "virtual" : "real") + " time";
+      spdlog::error("broker at {} bus {}: {}", endpoint_.ToString(), options_.bus, detail);
+      Fail(detail);
+      if (on_connection) on_connection(false, detail);
+      return;
+    }
     timer_.cancel();
     phase_ = Phase::kConnected;
     backoff_ = options_.initial_backoff;
-    session_ = {reply.port_id(), reply.bitrate(), reply.mode() != wire::BUS_MODE_UNPACED};
+    session_ = {reply.port_id(), reply.bitrate(), reply.mode() != wire::BUS_MODE_UNPACED,
+                reply.virtual_time()};
+    held_.clear();
+    held_requests_.clear();
+    if (options_.virtual_time) {
+      const std::uint64_t gen_before = generation_;
+      options_.virtual_time->Connected(options_.virtual_time_index, *this,
+                                       TimePoint(Duration(reply.time_ns())));
+      if (gen_before != generation_) return;
+    }
     ++stats_.connects;
     error_frame_logged_ = false;
     const bool other_rate = options_.bitrate != 0 && options_.bitrate != session_.bitrate;
@@ -358,6 +463,8 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
   void Fail(const std::string& reason) {
     if (phase_ == Phase::kStopped) return;
     const bool was_connected = phase_ == Phase::kConnected;
+    if (was_connected && options_.virtual_time)
+      options_.virtual_time->Disconnected(options_.virtual_time_index);
     ++generation_;
     CloseSocket();
     timer_.cancel();
@@ -462,6 +569,15 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link> {
 
   ControllerState state_ = ControllerState::kErrorActive;
   bool error_frame_logged_ = false;
+  /// Virtual time: what the broker sent since its last grant.
+  struct Held {
+    wire::MessageType type;
+    wire::StampedFrame frame;
+    canfleet::ControllerEvent controller;
+    std::size_t request = 0;  ///< into held_requests_
+  };
+  std::vector<Held> held_;
+  std::vector<wire::NodeRequest> held_requests_;
   BrokerSession session_;
   BrokerClientStats stats_;
 };

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "bus/broker_client/virtual_time_client.hpp"
 #include "bus/bus_port.hpp"
 #include "bus/wire/canfleet_wire.pb.h"
 
@@ -37,6 +38,10 @@ struct BrokerClientOptions {
   std::chrono::milliseconds handshake_timeout{5000};
   /// Frames waiting to be written to the socket; a Send beyond this returns false.
   std::size_t transmit_queue_frames = 65536;
+  /// Lock-step virtual time (virtual_time_client.hpp): the process's client, which must outlive
+  /// the port, and this port's index among the process's ports. nullptr: real time.
+  VirtualTimeClient* virtual_time = nullptr;
+  std::size_t virtual_time_index = 0;
 };
 
 /// What the broker told us when it accepted the Hello.
@@ -44,6 +49,7 @@ struct BrokerSession {
   std::uint32_t port_id = 0;
   std::uint32_t bitrate = 0;  ///< bit/s
   bool paced = true;
+  bool virtual_time = false;
 };
 
 struct BrokerClientStats {
@@ -75,6 +81,9 @@ struct BrokerClientStats {
 ///   exponential backoff ("broker connection lost: ...; reconnecting in 400 ms"). While it is
 ///   disconnected Send returns false: the frames are lost, as on an unplugged cable. Each new
 ///   connection is a new controller: error-active, counters 0.
+/// - In virtual time (BrokerClientOptions::virtual_time), what the broker sends is held until its
+///   TimeGrant and applied then, frames leave stamped with the node's time, and every grant is
+///   answered with TimeReached (virtual_time_client.hpp).
 class BrokerClientPort final : public BusPort {
  public:
   /// `connected`: true once a Hello is accepted; false when that connection is lost, and also when

@@ -133,6 +133,23 @@ void MessageWriter::AddBitRate(std::uint32_t bitrate) {
   AppendProto([&](Envelope& e) { e.mutable_bit_rate()->set_bitrate(bitrate); });
 }
 
+void MessageWriter::AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns) {
+  AppendProto([&](Envelope& e) {
+    auto* grant = e.mutable_time_grant();
+    grant->set_now_ns(now_ns);
+    grant->set_until_ns(until_ns);
+  });
+}
+
+void MessageWriter::AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns) {
+  AppendProto([&](Envelope& e) {
+    auto* reached = e.mutable_time_reached();
+    reached->set_time_ns(time_ns);
+    reached->set_has_deadline(next_deadline_ns.has_value());
+    reached->set_next_deadline_ns(next_deadline_ns.value_or(0));
+  });
+}
+
 void MessageWriter::Clear() {
   buffer_.clear();
   batch_open_ = false;

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <span>
 #include <string_view>
 
@@ -90,6 +91,10 @@ class MessageWriter {
   void AddNodeReply(const NodeReply& reply);
   /// BitRate{bitrate}: the node's controller now runs at `bitrate` bit/s (0: the bus's rate).
   void AddBitRate(std::uint32_t bitrate);
+  /// TimeGrant{now_ns, until_ns} (virtual time, broker -> node).
+  void AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns);
+  /// TimeReached{time_ns, next deadline} (virtual time, node -> broker); no deadline: nullopt.
+  void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns);
   /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write
   /// that went to the socket only in part), after closing the open batch.
   void AddEncoded(const std::uint8_t* bytes, std::size_t size);

@@ -28,6 +28,10 @@ const char* ToString(MessageType type) {
       return "NodeReply";
     case MessageType::kBitRate:
       return "BitRate";
+    case MessageType::kTimeGrant:
+      return "TimeGrant";
+    case MessageType::kTimeReached:
+      return "TimeReached";
   }
   return "unknown";
 }

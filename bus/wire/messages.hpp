@@ -22,7 +22,8 @@ namespace canfleet::wire {
 /// another version is refused with a reason naming both.
 /// 2: NodeRequest / NodeReply.
 /// 3: Hello.bitrate and BitRate (the node's controller bit rate).
-inline constexpr std::uint32_t kProtocolVersion = 3;
+/// 4: virtual time (Hello.virtual_time, TimeGrant, TimeReached).
+inline constexpr std::uint32_t kProtocolVersion = 4;
 
 /// Largest Envelope (without its length prefix). Longer = protocol error.
 inline constexpr std::size_t kMaxMessageSize = std::size_t{1} << 20;
@@ -46,6 +47,8 @@ enum class MessageType : std::uint8_t {
   kNodeRequest,  ///< broker -> node: envelope.node_request()
   kNodeReply,    ///< node -> broker: envelope.node_reply()
   kBitRate,      ///< node -> broker: envelope.bit_rate()
+  kTimeGrant,    ///< broker -> node (virtual time): envelope.time_grant()
+  kTimeReached,  ///< node -> broker (virtual time): envelope.time_reached()
 };
 
 const char* ToString(MessageType type);
@@ -58,7 +61,8 @@ struct Message {
   FrameRecords frames;
   /// kControllerEvent, converted and range-checked.
   canfleet::ControllerEvent controller;
-  /// kHello, kHelloReply, kPing, kPong, kError, kNodeRequest, kNodeReply, kBitRate: the parsed Envelope
+  /// kHello, kHelloReply, kPing, kPong, kError, kNodeRequest, kNodeReply, kBitRate, kTimeGrant,
+  /// kTimeReached: the parsed Envelope
   /// (envelope.hello(), ...).
   Envelope envelope;
 };

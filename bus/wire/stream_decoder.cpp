@@ -226,6 +226,27 @@ bool StreamDecoder::DecodeEnvelope(std::span<const std::uint8_t> body, Message& 
     case Envelope::kBitRate:
       out.type = MessageType::kBitRate;
       return true;
+    case Envelope::kTimeGrant: {
+      const TimeGrant& grant = out.envelope.time_grant();
+      if (grant.now_ns() < 0 || grant.until_ns() <= grant.now_ns()) {
+        error_ = "TimeGrant until_ns " + std::to_string(grant.until_ns()) + " not after now_ns " +
+                 std::to_string(grant.now_ns()) + " (or negative)";
+        return false;
+      }
+      out.type = MessageType::kTimeGrant;
+      return true;
+    }
+    case Envelope::kTimeReached: {
+      const TimeReached& reached = out.envelope.time_reached();
+      if (reached.time_ns() < 0 ||
+          (reached.has_deadline() && reached.next_deadline_ns() <= reached.time_ns())) {
+        error_ = "TimeReached next_deadline_ns " + std::to_string(reached.next_deadline_ns()) +
+                 " not after time_ns " + std::to_string(reached.time_ns()) + " (or negative)";
+        return false;
+      }
+      out.type = MessageType::kTimeReached;
+      return true;
+    }
     case Envelope::BODY_NOT_SET:
       break;
   }

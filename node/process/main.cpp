@@ -3,16 +3,19 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/post.hpp>
 #include <asio/signal_set.hpp>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "bus/broker_client/broker_client_port.hpp"
 #include "bus/socketcan/socketcan_port.hpp"
 #include "clock/asio_scheduler.hpp"
+#include "clock/granted_scheduler.hpp"
 #include "node/canopen/lss/lss_protocol.hpp"
 #include "node/canopen/storage/atomic_file.hpp"
 #include "node/devices/device_node.hpp"
@@ -32,9 +35,13 @@ constexpr const char* kVersion = "canfleet-node 0.1.0";
 
 std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spec,
                                   const node::NodeOptions& options, std::uint8_t node_id,
-                                  std::shared_ptr<spdlog::logger> log,
-                                  std::function<void()> on_first_connect) {
+                                  std::shared_ptr<spdlog::logger> log, VirtualTimeClient* virtual_time,
+                                  std::size_t index, std::function<void()> on_first_connect) {
   if (spec.socketcan) {
+    if (virtual_time != nullptr)
+      throw std::invalid_argument("--time virtual: port " + std::to_string(index + 1) +
+                                  " is SocketCAN interface " + spec.bus +
+                                  ", which lives in real time; a node in virtual time needs broker buses");
     auto port = std::make_unique<SocketCanPort>(io, spec.bus);
     port->OnError([log](std::error_code ec) { log->error("socketcan: {}", ec.message()); });
     asio::post(io, on_first_connect);
@@ -45,6 +52,8 @@ std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spe
   client.bus = spec.bus;
   client.node_name = options.name;
   client.node_id = node::BrokerHelloNodeId(node_id);
+  client.virtual_time = virtual_time;
+  client.virtual_time_index = index;
   auto port = std::make_unique<BrokerClientPort>(io, client);
   port->OnConnection(
       [log, started = false, on_first_connect](bool connected, const std::string& detail) mutable {
@@ -81,7 +90,17 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   }
 
   asio::io_context io;
-  AsioScheduler scheduler(io);
+  // Real time, or time granted by the broker (--time virtual): the node's code is the same.
+  std::unique_ptr<Scheduler> scheduler_owner;
+  std::optional<VirtualTimeClient> virtual_time;
+  if (options.virtual_time) {
+    auto granted = std::make_unique<GrantedScheduler>();
+    virtual_time.emplace(*granted, options.name + "#" + std::to_string(::getpid()), port_count);
+    scheduler_owner = std::move(granted);
+  } else {
+    scheduler_owner = std::make_unique<AsioScheduler>(io);
+  }
+  Scheduler& scheduler = *scheduler_owner;
   devices::NodeSettings settings;
   settings.state_dir = options.state_dir;
   settings.serial_number = options.serial_number;
@@ -137,7 +156,8 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   for (std::size_t p = 0; p < port_count; ++p) {
     auto id = options.node_ids.size() == 1 ? options.node_ids[0] : options.node_ids[p];
     settings.ports.push_back({id, bit_timing});
-    ports.push_back(MakePort(io, options.buses[p], options, id, log, start_when_all_connected));
+    ports.push_back(MakePort(io, options.buses[p], options, id, log, virtual_time ? &*virtual_time : nullptr,
+                             p, start_when_all_connected));
     raw_ports.push_back(ports.back().get());
   }
   node = std::make_unique<devices::DeviceNode>(std::move(device), scheduler, raw_ports, settings);
@@ -230,6 +250,11 @@ int main(int argc, char** argv) {
   app.add_flag("--factory-bit-rate", options.factory_bit_rate,
                "a port with no bit rate configured (LSS, 5B50h) runs at the variant's factory rate, as a "
                "factory-new device plugged into the bus (default: commissioned for its bus's rate)");
+  std::string time_mode = "real";
+  app.add_option("--time", time_mode,
+                 "real: the node keeps real time; virtual: it runs on the time its broker grants (a bus in "
+                 "virtual time, canfleet up --time virtual)")
+      ->check(CLI::IsMember({"real", "virtual"}));
   app.add_flag("--stdin-control", options.stdin_control,
                "accept set/get/list/nmt commands on standard input");
   app.add_option("--log-level", options.log_level, "trace, debug, info, warn, error")
@@ -274,6 +299,10 @@ int main(int argc, char** argv) {
       options.node_ids.push_back(static_cast<std::uint8_t>(id));
     }
     if (*serial_opt) options.serial_number = serial;
+    options.virtual_time = time_mode == "virtual";
+    if (options.virtual_time && options.stdin_control)
+      throw std::invalid_argument(
+          "--stdin-control works in real time only (use canfleet io in virtual time)");
     if (options.name.empty()) {
       options.name = (options.device.empty() ? options.eds.stem().string() : options.device) + "@" +
                      std::to_string(node_ids[0]);

@@ -29,6 +29,9 @@ struct NodeOptions {
   /// --factory-bit-rate: a port with no rate configured runs at the manual's factory rate rather
   /// than being commissioned for its bus (node/process/bit_rate_commissioning.hpp).
   bool factory_bit_rate = false;
+  /// --time virtual: the node runs on time granted by the broker (lock-step virtual time,
+  /// bus/broker_client/virtual_time_client.hpp); every port must be a broker connection.
+  bool virtual_time = false;
   std::string log_level = "info";
 };
 

@@ -194,7 +194,7 @@ void FaultManager::ApplyHeartbeatLoss(Fault& fault) {
   rule.receivers = ReceiverPorts(fault.bus, fault.spec);
   rule.action = broker::RuleAction::kDrop;
   rule.probability = fault.spec.probability() > 0 ? fault.spec.probability() : 1.0;
-  rule.seed = fault.spec.seed();
+  rule.seed = fault.spec.seed() != 0 ? fault.spec.seed() : ctx_.seed != 0 ? ctx_.seed + fault.id : 0;
   if (fault.spec.count() > 0) rule.count = fault.spec.count();
   fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));
 }
@@ -241,7 +241,7 @@ void FaultManager::ApplyFrameFault(Fault& fault) {
       break;
   }
   rule.probability = spec.probability() > 0 ? spec.probability() : 1.0;
-  rule.seed = spec.seed();
+  rule.seed = spec.seed() != 0 ? spec.seed() : ctx_.seed != 0 ? ctx_.seed + fault.id : 0;
   if (spec.count() > 0) rule.count = spec.count();
   try {
     fault.rules.push_back(ctx_.broker.Faults(fault.bus).Add(rule));

@@ -36,6 +36,9 @@ class FaultManager {
     TimePoint origin{};  ///< uptime 0
     /// A fault began (`started`) or ended; for the log and telemetry.
     std::function<void(const control::FaultStatus&, bool started)> on_event;
+    /// Seed of the random draws of a fault that gives none: the fleet's seed (topology
+    /// `time.seed`) plus the fault's id, so a run repeats itself.
+    std::uint64_t seed = 0;
   };
 
   explicit FaultManager(Context context);

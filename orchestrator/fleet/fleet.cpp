@@ -113,6 +113,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
           [this](const control::FaultStatus& status, bool started) {
             if (on_fault_event_) on_fault_event_(status, started);
           },
+      .seed = options_.seed,
   });
   for (const auto& node : nodes_)
     if (!node.external()) supervisor_.Add(node.name(), NodeLaunch(node, options_), PolicyOf(node.spec));

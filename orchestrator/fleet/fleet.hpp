@@ -31,6 +31,7 @@
 #include "orchestrator/scenario/scenario_runner.hpp"
 #include "orchestrator/topology/canfleet_topology.pb.h"
 #include "orchestrator/transport/broker_server.hpp"
+#include "orchestrator/transport/time_conductor.hpp"
 
 namespace canfleet::fleet {
 
@@ -48,6 +49,10 @@ struct FleetOptions {
   /// Run the scenario again after topology.scenario_repeat_ms (`canfleet up`); false: once
   /// (`canfleet test` judges one run).
   bool repeat_scenario = false;
+  /// Virtual time: the broker's time conductor (status shows simulated time and the factor).
+  const transport::TimeConductor* conductor = nullptr;
+  /// Seed of the random draws of faults that give none (topology `time.seed`).
+  std::uint64_t seed = 0;
 };
 
 class Fleet final : public control::ControlHandler, public scenario::FleetProbe {
@@ -64,6 +69,14 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   void OnShutdownRequest(std::function<void()> handler) { on_shutdown_request_ = std::move(handler); }
   /// Stops every node process (SIGTERM, then SIGKILL after a grace time); `done` runs after.
   void Stop(std::function<void()> done);
+  /// Starts a capture of a bus to a file, as the control API's CaptureStart does (`canfleet test
+  /// --capture`). @throws std::invalid_argument or std::system_error.
+  control::CaptureStarted StartCapture(const control::CaptureStart& request) {
+    return captures_.Start(request);
+  }
+  /// Ends every capture now (`canfleet test` ends them with the scenario, so a capture in virtual
+  /// time ends at the same simulated instant on every run, not when the processes happen to stop).
+  void StopCaptures() { captures_.Stop(0); }
 
   /// A fault began or ended (the fault event log): for telemetry.
   void OnFaultEvent(std::function<void(const control::FaultStatus&, bool started)> handler) {

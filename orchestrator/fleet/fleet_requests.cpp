@@ -135,6 +135,11 @@ control::Status Fleet::Status() const {
   control::Status status;
   status.set_topology(options_.topology.name());
   status.set_uptime_s(Uptime());
+  if (options_.conductor != nullptr) {
+    status.set_virtual_time(true);
+    status.set_speed_factor(options_.conductor->Factor());
+    status.set_speed(options_.conductor->Speed());
+  }
   std::map<std::pair<std::string, std::string>, broker::PortStats> ports;  // (bus, name)
   std::map<std::string, std::uint32_t> bus_rates;
   for (const auto& bus : broker_.Buses()) {

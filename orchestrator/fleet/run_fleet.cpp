@@ -35,6 +35,13 @@ void WriteStateFile(const std::filesystem::path& path, const std::string& contro
 
 }  // namespace
 
+std::size_t StartedProcesses(const topology::Topology& spec) {
+  std::size_t count = 0;
+  for (const auto& node : spec.node())
+    count += node.external() ? 0 : 1;
+  return count;
+}
+
 std::filesystem::path FindNodeBinary(const std::filesystem::path& asked) {
   if (!asked.empty()) {
     if (::access(asked.c_str(), X_OK) != 0)
@@ -79,8 +86,16 @@ int RunFleet(const UpOptions& options) {
   asio::io_context io(1);
   socketcand::ServerOptions socketcand_options;
   socketcand_options.bind_address = options.socketcand_bind;
-  host::BrokerHost host(io, socketcand_options);
+  host::HostTime time;
+  try {
+    time = FleetTime(spec, options.time);
+  } catch (const std::exception& e) {
+    std::cerr << "canfleet up: " << e.what() << "\n";
+    return 2;
+  }
+  host::BrokerHost host(io, socketcand_options, time);
   std::unique_ptr<Fleet> fleet;
+  std::unique_ptr<BoundaryControlHandler> boundary;
   std::unique_ptr<control::ControlServer> control_server;
   std::string control_endpoint, broker_endpoint;
   try {
@@ -104,9 +119,18 @@ int RunFleet(const UpOptions& options) {
     fleet_options.node_arguments = telemetry::DdsArguments(options.dds);
     fleet_options.wall_origin = host.wall_origin();
     fleet_options.repeat_scenario = true;
+    fleet_options.seed = spec.time().seed();
+    fleet_options.conductor = host.conductor();
+    if (host.conductor())
+      fleet_options.node_arguments.insert(fleet_options.node_arguments.end(), {"--time", "virtual"});
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
-    control_server = std::make_unique<control::ControlServer>(io, *fleet);
+    control::ControlHandler* handler = fleet.get();
+    if (host.conductor()) {
+      boundary = std::make_unique<BoundaryControlHandler>(*fleet, *host.conductor());
+      handler = boundary.get();
+    }
+    control_server = std::make_unique<control::ControlServer>(io, *handler);
     const auto bound = control_server->Listen(spec.orchestrator().control());
     control_endpoint = "tcp://" + wire::TcpEndpointText(bound);
   } catch (const std::exception& e) {
@@ -153,6 +177,12 @@ int RunFleet(const UpOptions& options) {
   fleet->OnShutdownRequest([&] { shutdown("canfleet down"); });
   host.OnSignal(shutdown);
   fleet->Start();
+  if (auto* conductor = host.conductor()) {
+    spdlog::info("virtual time: {}", conductor->Speed() > 0
+                                         ? "paced at " + std::to_string(conductor->Speed()) + "x real time"
+                                         : std::string("as fast as the processes go"));
+    if (!options.no_start) conductor->HoldUntilJoined(StartedProcesses(spec), kJoinTimeout);
+  }
   io.run();
   control_server.reset();
   fleet.reset();

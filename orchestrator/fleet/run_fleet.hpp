@@ -6,7 +6,9 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include "orchestrator/fleet/fleet_time.hpp"
 
+#include "orchestrator/topology/canfleet_topology.pb.h"
 #include "telemetry/dds.hpp"
 
 namespace canfleet::fleet {
@@ -23,7 +25,11 @@ struct UpOptions {
   bool telemetry = true;  ///< BusStats and FaultEvents on DDS
   /// Where the orchestrator publishes (canfleet up's --dds-* options); also passed to its nodes.
   telemetry::DdsOptions dds;
+  TimeOverride time;  ///< --time / --speed; empty: the topology's time
 };
+
+/// The node processes a fleet of `spec` starts itself (external nodes are started elsewhere).
+std::size_t StartedProcesses(const topology::Topology& spec);
 
 /// canfleet-node: `asked` when given (it must be executable), else beside this executable, else on
 /// PATH. Throws std::runtime_error naming what was tried.

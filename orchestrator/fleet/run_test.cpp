@@ -9,6 +9,7 @@
 #include <asio/io_context.hpp>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
 #include "bus/wire/tcp_endpoint_text.hpp"
 #include "orchestrator/control/control_server.hpp"
@@ -97,8 +98,16 @@ class FileRun {
   void Drive(const topology::LoadedTopology& loaded) {
     const auto& spec = loaded.spec;
     asio::io_context io(1);
-    host::BrokerHost host(io);
+    host::HostTime time;
+    try {
+      time = FleetTime(spec, options_.time);
+    } catch (const std::exception& e) {
+      Error(e.what());
+      return;
+    }
+    host::BrokerHost host(io, {}, time);
     std::unique_ptr<Fleet> fleet;
+    std::unique_ptr<BoundaryControlHandler> boundary;
     std::unique_ptr<control::ControlServer> control_server;
     Scheduler& scheduler = host.scheduler();
     const TimePoint begin = scheduler.Now();
@@ -120,8 +129,27 @@ class FileRun {
       fleet_options.node_arguments = telemetry::DdsArguments(options_.dds);
       if (!options_.telemetry) fleet_options.node_arguments.push_back("--no-telemetry");
       fleet_options.wall_origin = host.wall_origin();
+      fleet_options.seed = options_.seed ? *options_.seed : spec.time().seed();
+      fleet_options.conductor = host.conductor();
+      if (host.conductor())
+        fleet_options.node_arguments.insert(fleet_options.node_arguments.end(), {"--time", "virtual"});
       fleet = std::make_unique<Fleet>(io, scheduler, host.broker(), host.server(), std::move(fleet_options));
-      control_server = std::make_unique<control::ControlServer>(io, *fleet);
+      control::ControlHandler* handler = fleet.get();
+      if (host.conductor()) {
+        boundary = std::make_unique<BoundaryControlHandler>(*fleet, *host.conductor());
+        handler = boundary.get();
+      }
+      control_server = std::make_unique<control::ControlServer>(io, *handler);
+      if (!options_.capture.empty()) {
+        fs::create_directories(options_.capture);
+        for (const auto& bus : spec.bus()) {
+          control::CaptureStart capture;
+          capture.set_bus(bus.name());
+          capture.set_format("candump");
+          capture.set_path((options_.capture / (file_.stem().string() + "-" + bus.name() + ".log")).string());
+          fleet->StartCapture(capture);
+        }
+      }
       const auto bound = control_server->Listen(spec.orchestrator().control());
       spdlog::info("canfleet test {}: control API on tcp://{}, nodes connect to {}", report_.file,
                    wire::TcpEndpointText(bound), host.Endpoints().front().ToString());
@@ -171,14 +199,21 @@ class FileRun {
           result.step < static_cast<int>(lines_.size()) ? lines_[static_cast<std::size_t>(result.step)] : 0;
       out_ << scenario::ResultLine(report_.file, line, result) << std::endl;
     });
-    fleet->OnScenarioDone([&] { shutdown("scenario done"); });
+    std::optional<TimePoint> scenario_end;
+    fleet->OnScenarioDone([&] {
+      scenario_end = scheduler.Now();
+      fleet->StopCaptures();
+      shutdown("scenario done");
+    });
     host.OnSignal([&](const char* name) {
       Error(std::string("interrupted (") + name + ")");
       shutdown(name);
     });
     fleet->Start();
+    if (auto* conductor = host.conductor()) conductor->HoldUntilJoined(StartedProcesses(spec), kJoinTimeout);
     io.run();
     watchdog_.reset();
+    if (auto* conductor = host.conductor()) report_.factor = conductor->Factor();
 
     report_.results = fleet->ScenarioResults();
     if (const auto origin = fleet->ScenarioOrigin()) report_.origin = *origin;
@@ -191,7 +226,13 @@ class FileRun {
       r.verdict.outcome = scenario::Outcome::kSkipped;
       r.verdict.detail = report_.error.empty() ? "not judged" : "not judged: " + report_.error;
     }
-    report_.seconds = std::chrono::duration<double>(scheduler.Now() - begin).count();
+    report_.seconds = std::chrono::duration<double>(scenario_end.value_or(scheduler.Now()) - begin).count();
+    if (report_.factor > 0) {
+      char line[160];
+      std::snprintf(line, sizeof line, ": virtual time, %.1f s simulated at %.1fx real time", report_.seconds,
+                    report_.factor);
+      out_ << "      " << report_.file << line << std::endl;
+    }
     control_server.reset();
     fleet.reset();
   }
@@ -220,12 +261,6 @@ std::string SafeName(std::string name) {
 }  // namespace
 
 int RunTests(const TestOptions& options, std::ostream& out) {
-  if (options.time_mode == "virtual") {
-    out << "canfleet test: --time virtual is not available yet (lock-step virtual time, issue 20 part 2); "
-           "use "
-           "--time real\n";
-    return 2;
-  }
   fs::path base = options.state_dir;
   const bool temporary = base.empty();
   if (temporary) {
@@ -239,7 +274,7 @@ int RunTests(const TestOptions& options, std::ostream& out) {
   }
   scenario::JunitRun run;
   run.seed = options.seed;
-  run.time_mode = options.time_mode;
+  run.time_mode = options.time.mode.empty() ? "topology" : options.time.mode;
   bool refused = false;
   double seconds = 0;
   for (std::size_t i = 0; i < options.files.size(); ++i) {

@@ -14,6 +14,7 @@
 #include <ostream>
 #include <string>
 #include <vector>
+#include "orchestrator/fleet/fleet_time.hpp"
 
 #include "telemetry/dds.hpp"
 
@@ -22,8 +23,11 @@ namespace canfleet::fleet {
 struct TestOptions {
   std::vector<std::filesystem::path> files;
   std::filesystem::path junit;        ///< empty: no JUnit report
-  std::string time_mode = "real";     ///< "real"; "virtual" is refused until virtual time exists
-  std::optional<std::uint64_t> seed;  ///< recorded in the report
+  TimeOverride time;                  ///< --time / --speed; empty: each topology's
+  std::optional<std::uint64_t> seed;  ///< recorded in the report; seeds faults that give none
+  /// Each bus of each fleet captured in candump log format to <capture>/<file stem>-<bus>.log
+  /// (from before the first node starts). Empty: no capture.
+  std::filesystem::path capture;
   std::filesystem::path node_binary;  ///< canfleet-node; empty: FindNodeBinary's search
   /// Where each fleet keeps its state and logs (<state_dir>/<n>-<topology name>/, the
   /// orchestrator's log is orchestrator.log there). Empty: a fresh folder under the system's

@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <csignal>
+#include <stdexcept>
 
 namespace canfleet::host {
 
@@ -13,15 +15,48 @@ socketcand::ServerOptions WithOrigin(socketcand::ServerOptions options, WallTime
   return options;
 }
 
+std::unique_ptr<Scheduler> MakeScheduler(asio::io_context& io, const HostTime& time) {
+  if (time.virtual_time) return std::make_unique<GrantedScheduler>();
+  return std::make_unique<AsioScheduler>(io);
+}
+
+std::unique_ptr<transport::TimeConductor> MakeConductor(asio::io_context& io, Scheduler& scheduler,
+                                                        broker::Broker& broker, const HostTime& time) {
+  if (!time.virtual_time) return nullptr;
+  return std::make_unique<transport::TimeConductor>(io, static_cast<GrantedScheduler&>(scheduler), broker,
+                                                    time.conductor);
+}
+
+transport::BrokerServerOptions ServerOptions(transport::TimeConductor* conductor) {
+  transport::BrokerServerOptions options;
+  options.time_conductor = conductor;
+  return options;
+}
+
 }  // namespace
 
-BrokerHost::BrokerHost(asio::io_context& io, socketcand::ServerOptions socketcand_options)
+double ParseSpeed(const std::string& text) {
+  if (text == "max") return 0;
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(value) || value <= 0)
+    throw std::invalid_argument("--speed " + text + ": give max or a positive factor of real time (10, 0.5)");
+  return value;
+}
+
+BrokerHost::BrokerHost(asio::io_context& io, socketcand::ServerOptions socketcand_options, HostTime time)
     : io_(io),
-      scheduler_(io),
-      wall_origin_(WallClockOrigin(scheduler_)),
-      broker_(scheduler_),
-      server_(io, broker_),
-      socketcand_(io, broker_, scheduler_, WithOrigin(std::move(socketcand_options), wall_origin_)),
+      scheduler_(MakeScheduler(io, time)),
+      wall_origin_(time.virtual_time ? WallTime{} : WallClockOrigin(*scheduler_)),
+      broker_(*scheduler_),
+      conductor_(MakeConductor(io, *scheduler_, broker_, time)),
+      server_(io, broker_, ServerOptions(conductor_.get())),
+      socketcand_(io, broker_, *scheduler_, WithOrigin(std::move(socketcand_options), wall_origin_)),
       signals_(io, SIGINT, SIGTERM),
       drain_(io) {}
 
@@ -33,11 +68,18 @@ BrokerHost::~BrokerHost() {
 }
 
 void BrokerHost::AddBus(const broker::BusConfig& config) {
+  if (conductor_ && !config.paced)
+    throw std::invalid_argument("bus " + config.name +
+                                ": an unpaced bus has no time line, so it cannot run in virtual time");
   broker_.AddBus(config);
   spdlog::info("bus {}: {} bit/s, {}", config.name, config.bitrate, config.paced ? "paced" : "unpaced");
 }
 
 std::uint16_t BrokerHost::ServeSocketcand(const std::string& bus, std::uint16_t port) {
+  if (conductor_)
+    throw std::invalid_argument("bus " + bus +
+                                ": socketcand is not served in virtual time (its clients live in real time; "
+                                "watch the bus with canfleet dump or a monitor instead)");
   const std::uint16_t bound = socketcand_.Serve(bus, port);
   spdlog::info("bus {}: socketcand on port {}", bus, bound);
   return bound;
@@ -51,7 +93,7 @@ bool BrokerHost::StartTelemetry(const telemetry::DdsOptions& dds, std::chrono::m
   try {
     participant_.emplace(dds);
     publisher_.emplace(*participant_, telemetry::OrchestratorTelemetryOptions{.period = period});
-    bus_telemetry_.emplace(broker_, scheduler_, *publisher_,
+    bus_telemetry_.emplace(broker_, *scheduler_, *publisher_,
                            broker::BrokerTelemetryOptions{.period = period});
     spdlog::info("telemetry on DDS domain {}", dds.domain_id);
     return true;

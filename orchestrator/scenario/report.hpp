@@ -22,7 +22,8 @@ struct FileReport {
   /// not decided is then skipped, and the suite has an error.
   std::string error;
   TimePoint origin{};  ///< the scenario's start, for times in messages
-  double seconds = 0;  ///< the whole run, start of the fleet to its stop
+  double seconds = 0;  ///< the whole run, start of the fleet to its stop (simulated in virtual time)
+  double factor = 0;   ///< virtual time: simulated seconds per real second achieved; 0 in real time
 };
 
 /// Totals over results (pending ones count as skipped).

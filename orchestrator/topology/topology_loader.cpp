@@ -4,6 +4,7 @@
 #include <google/protobuf/text_format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <map>
@@ -50,6 +51,7 @@ class Loader {
     const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1});
     CheckTopology(root);
     CheckOrchestrator(root);
+    CheckTime(root);
     CheckBuses(root);
     NodeChecks nodes(facts_);
     nodes.CheckNodes(root);
@@ -105,6 +107,28 @@ class Loader {
     }
     facts_.state_root = o.state_root().empty() ? (facts_.dir / ".canfleet" / spec_.name()).lexically_normal()
                                                : facts_.Resolve(o.state_root());
+  }
+
+  /// Virtual time needs paced buses (a time line) and nothing that lives in real time.
+  void CheckTime(const Scope& root) {
+    if (!spec_.has_time()) return;
+    const Time& t = spec_.time();
+    const Scope s = root.Child("time", t);
+    if (t.speed() < 0 || !std::isfinite(t.speed()))
+      s.Fail("speed", "must be 0 (as fast as possible) or a positive factor of real time");
+    if (t.mode() != Time::VIRTUAL) return;
+    for (int i = 0; i < spec_.bus_size(); ++i) {
+      const Bus& bus = spec_.bus(i);
+      const Scope b = root.Child("bus", bus, i);
+      if (bus.unpaced()) b.Fail("unpaced", "an unpaced bus has no time line: it cannot run in virtual time");
+      if (bus.socketcand_port() != 0)
+        b.Fail("socketcand_port", "socketcand clients live in real time: not served in virtual time");
+    }
+    for (int i = 0; i < spec_.node_size(); ++i)
+      if (spec_.node(i).external())
+        root.Child("node", spec_.node(i), i)
+            .Fail("external",
+                  "a node started elsewhere keeps real time: not part of a fleet in virtual time");
   }
 
   static void CheckEndpoint(const Scope& s, std::string_view field, int index, const std::string& text) {

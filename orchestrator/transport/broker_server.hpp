@@ -25,6 +25,7 @@ namespace canfleet::transport {
 namespace detail {
 class NodeSession;
 }
+class TimeConductor;
 
 struct BrokerServerOptions {
   /// Bytes a session may have waiting for a slow reader; deliveries beyond it are dropped and
@@ -37,6 +38,9 @@ struct BrokerServerOptions {
   std::chrono::milliseconds close_linger{1'000};
   /// RequestNode gives up (nullopt) when the node has not answered by then.
   std::chrono::milliseconds node_request_timeout{3'000};
+  /// Lock-step virtual time (time_conductor.hpp): the conductor of every bus of this broker, which
+  /// must outlive the server. nullptr: real time.
+  TimeConductor* time_conductor = nullptr;
 };
 
 struct BrokerServerStats {

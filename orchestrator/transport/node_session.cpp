@@ -135,13 +135,21 @@ void NodeSession::Handle(const wire::Message& m) {
   }
   switch (m.type) {
     case MessageType::kHello:
-      if (port_ != 0) {
+      if (port_ != 0 || hello_seen_) {
         ProtocolError("second Hello");
         return;
       }
+      hello_seen_ = true;
       OnHello(m.envelope.hello());
       return;
     case MessageType::kFrames: {
+      if (granted_) {
+        stamped_.resize(m.frames.size());
+        for (std::size_t i = 0; i < m.frames.size(); ++i)
+          stamped_[i] = m.frames[i];
+        options_.time_conductor->Submit(*this, port_, stamped_);
+        return;
+      }
       submit_.resize(m.frames.size());
       for (std::size_t i = 0; i < m.frames.size(); ++i)
         submit_[i] = m.frames[i].frame;
@@ -164,6 +172,17 @@ void NodeSession::Handle(const wire::Message& m) {
     case MessageType::kBitRate:
       OnBitRate(m.envelope.bit_rate().bitrate());
       return;
+    case MessageType::kTimeReached: {
+      const auto& reached = m.envelope.time_reached();
+      const auto next = reached.has_deadline()
+                            ? std::optional(TimePoint(Duration(reached.next_deadline_ns())))
+                            : std::nullopt;
+      if (!granted_ || !options_.time_conductor->Reached(*this, TimePoint(Duration(reached.time_ns())), next))
+        ProtocolError("TimeReached at " + std::to_string(reached.time_ns()) +
+                      " ns without a grant to that time");
+      return;
+    }
+    case MessageType::kTimeGrant:
     case MessageType::kHelloReply:
     case MessageType::kTxConfirm:
     case MessageType::kControllerEvent:
@@ -196,7 +215,7 @@ void NodeSession::Request(wire::NodeRequest request, NodeReplyHandler done) {
   });
   request.set_request_id(id);
   filling_.AddNodeRequest(request);
-  ScheduleFlush();
+  Queued();
 }
 
 void NodeSession::OnNodeReply(const wire::NodeReply& reply) {
@@ -244,20 +263,47 @@ void NodeSession::OnHello(const wire::Hello& hello) {
     Refuse("bit rate " + std::to_string(hello.bitrate()) + " outside 10000..1000000 bit/s");
     return;
   }
+  if (hello.role() != wire::ROLE_UNSPECIFIED && hello.role() != wire::ROLE_NODE &&
+      hello.role() != wire::ROLE_MONITOR) {
+    Refuse("unknown role " + std::to_string(hello.role()));
+    return;
+  }
+  const bool monitor = hello.role() == wire::ROLE_MONITOR;
+  TimeConductor* conductor = options_.time_conductor;
+  if (conductor == nullptr && hello.virtual_time()) {
+    Refuse("bus " + hello.bus() +
+           " runs in real time; this node was started for virtual time (--time virtual)");
+    return;
+  }
+  if (conductor != nullptr && !hello.virtual_time() && !monitor) {
+    Refuse("bus " + hello.bus() +
+           " runs in virtual time: a node must run on the broker's clock (canfleet-node --time virtual); "
+           "real-time clients may only watch (monitor role)");
+    return;
+  }
+  if (conductor != nullptr && !monitor && hello.clock_id().empty()) {
+    Refuse("a node in virtual time must name its clock (Hello.clock_id)");
+    return;
+  }
+  if (conductor == nullptr || monitor) {
+    Accept(hello);
+    return;
+  }
+  // Virtual time: a node joins between rounds, at the bus's time then.
+  timer_.cancel();
+  conductor->AtBoundary([this, self = shared_from_this(), hello] {
+    if (!closed_) Accept(hello);
+  });
+}
+
+void NodeSession::Accept(const wire::Hello& hello) {
   broker::AttachOptions attach;
   attach.bitrate = hello.bitrate();
-  switch (hello.role()) {
-    case wire::ROLE_UNSPECIFIED:
-    case wire::ROLE_NODE:
-      break;
-    case wire::ROLE_MONITOR:
-      attach.listen_only = true;
-      attach.error_frames = true;
-      break;
-    default:
-      Refuse("unknown role " + std::to_string(hello.role()));
-      return;
+  if (hello.role() == wire::ROLE_MONITOR) {
+    attach.listen_only = true;
+    attach.error_frames = true;
   }
+  TimeConductor* conductor = options_.time_conductor;
   std::string name = hello.node_name().empty() ? label_ : hello.node_name();
   try {
     port_ = broker_.Attach(hello.bus(), name, *this, attach);
@@ -279,9 +325,17 @@ void NodeSession::OnHello(const wire::Hello& hello) {
   reply.set_bitrate(bus.bitrate);
   reply.set_mode(bus.paced ? wire::BUS_MODE_PACED : wire::BUS_MODE_UNPACED);
   reply.set_port_id(port_);
+  if (conductor != nullptr) {
+    reply.set_virtual_time(true);
+    reply.set_time_ns(conductor->Now().time_since_epoch().count());
+  }
   filling_.AddHelloReply(reply);
   ScheduleFlush();
   stats_->attached++;
+  if (conductor != nullptr && hello.role() != wire::ROLE_MONITOR) {
+    granted_ = true;
+    conductor->Join(*this, hello.clock_id());
+  }
   spdlog::info("{}: attached ({}{}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
                hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string(),
                RateNote(hello.bitrate(), bus.bitrate));
@@ -321,6 +375,10 @@ void NodeSession::Close(const std::string& reason, Farewell farewell, spdlog::le
   const auto self = shared_from_this();  // on_closed_ drops the server's reference
   closed_ = true;
   spdlog::log(level, "{}: closed: {}", label_, reason);
+  if (granted_) {
+    granted_ = false;
+    options_.time_conductor->Leave(*this);
+  }
   if (port_ != 0) {
     broker_.Detach(port_);  // no sink call reaches us after this
     port_ = 0;
@@ -362,7 +420,7 @@ void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
     return;
   }
   filling_.AddFrames(wire::MessageType::kFrames, frames, Stamped);
-  ScheduleFlush();
+  Queued();
 }
 
 void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<const broker::FrameRun> runs) {
@@ -376,7 +434,8 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
-  if (!write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&
+  // In virtual time the grant that follows sends the frames: frames and grant in one write.
+  if (!granted_ && !write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&
       frames <= wire::kMaxFramesPerMessage) {
     WriteGathered(records, runs, frames);
     return;
@@ -385,7 +444,7 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
   for (const broker::FrameRun& run : runs)
     filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{run.begin} * wire::kFrameRecordSize,
                         run.size());
-  ScheduleFlush();
+  Queued();
 }
 
 void NodeSession::WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs,
@@ -409,13 +468,22 @@ void NodeSession::WriteGathered(const std::uint8_t* records, std::span<const bro
 
 void NodeSession::ControllerChanged(const ControllerEvent& event) {
   filling_.AddControllerEvent(event);
-  ScheduleFlush();
+  Queued();
 }
 
 void NodeSession::TxConfirmed(std::span<const broker::TimedFrame> frames) {
   if (!tx_confirmations_) return;
   filling_.AddFrames(wire::MessageType::kTxConfirm, frames, Stamped);
+  Queued();
+}
+
+void NodeSession::SendGrant(TimePoint now, TimePoint until) {
+  filling_.AddTimeGrant(now.time_since_epoch().count(), until.time_since_epoch().count());
   ScheduleFlush();
+}
+
+void NodeSession::Evict(const std::string& reason) {
+  Close(reason, Farewell::kError, spdlog::level::warn);
 }
 
 void NodeSession::ScheduleFlush() {

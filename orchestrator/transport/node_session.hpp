@@ -21,6 +21,7 @@
 #include "bus/wire/stream_decoder.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "orchestrator/transport/time_conductor.hpp"
 
 namespace canfleet::transport::detail {
 
@@ -31,7 +32,13 @@ namespace canfleet::transport::detail {
 ///
 /// As a PortSink it only appends to that buffer and schedules a flush for the end of the current
 /// io_context turn, so everything one broker round produced for this port goes out in one write.
-class NodeSession final : public std::enable_shared_from_this<NodeSession>, public broker::PortSink {
+///
+/// In virtual time (BrokerServerOptions::time_conductor) a node's session is a GrantedSession: its
+/// Hello is accepted between rounds, its frames go to the conductor with their times, and what is
+/// sent to it makes it take part in the next round.
+class NodeSession final : public std::enable_shared_from_this<NodeSession>,
+                          public broker::PortSink,
+                          public GrantedSession {
  public:
   using ClosedHandler = std::function<void(NodeSession*)>;
 
@@ -56,7 +63,7 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>, publ
 
   /// Attached to a bus and not closed.
   bool Attached() const { return port_ != 0 && !closed_; }
-  const std::string& Bus() const { return bus_; }
+  const std::string& Bus() const override { return bus_; }
   const std::string& NodeName() const { return node_name_; }
   /// Order of the accepted Hello among the server's sessions (later = larger).
   std::uint64_t AttachOrder() const { return attach_order_; }
@@ -71,7 +78,22 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>, publ
   void ControllerChanged(const ControllerEvent& event) override;
   void TxConfirmed(std::span<const broker::TimedFrame> frames) override;
 
+  // GrantedSession
+  void SendGrant(TimePoint now, TimePoint until) override;
+  void Evict(const std::string& reason) override;
+  const std::string& Label() const override { return label_; }
+
  private:
+  /// Attaches the port and answers the Hello (between rounds in virtual time).
+  void Accept(const wire::Hello& hello);
+  /// Something was queued for the node: in real time it leaves at the end of this turn; in
+  /// virtual time it happened now, and leaves with the grant of the next round.
+  void Queued() {
+    if (granted_)
+      options_.time_conductor->Pending(*this);
+    else
+      ScheduleFlush();
+  }
   /// Reads what the socket holds, then waits for more (bus/wire/socket_io.hpp).
   void Read();
   void WaitReadable();
@@ -113,10 +135,13 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>, publ
   std::uint64_t attach_order_ = 0;
   bool tx_confirmations_ = false;
   bool closed_ = false;
+  bool hello_seen_ = false;  ///< a Hello arrived (in virtual time it is accepted between rounds)
+  bool granted_ = false;     ///< a node in virtual time: the conductor grants its time
 
   wire::StreamDecoder decoder_;
   wire::Message message_;
-  std::vector<CanFrame> submit_;  ///< frames of one received batch, reused
+  std::vector<CanFrame> submit_;             ///< frames of one received batch, reused
+  std::vector<wire::StampedFrame> stamped_;  ///< the same in virtual time, with their times
 
   /// Runs per gathered write (the iovec array); a delivery cut into more (many per-receiver
   /// exceptions of the fault stage) is copied into filling_ instead.

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 
+#include "orchestrator/fleet/fleet_time.hpp"
 #include "orchestrator/fleet/run_test.hpp"
 #include "telemetry/cli_options.hpp"
 #include "tools/canfleet/cli.hpp"
@@ -13,7 +14,9 @@ namespace {
 struct TestArgs {
   std::vector<std::string> files;
   std::string junit;
-  std::string time = "real";
+  std::string time;  ///< "" = each topology's time.mode
+  std::string speed;
+  std::string capture;
   std::uint64_t seed = 0;
   std::string state_dir;
   std::string node_binary;
@@ -38,10 +41,19 @@ void AddTestCommand(CLI::App& app, Cli& cli) {
       ->required()
       ->check(CLI::ExistingFile);
   test->add_option("--junit", args->junit, "Write a JUnit XML report (one test suite per file)");
-  test->add_option("--time", args->time, "Time of the fleets: real (virtual: not available yet)")
-      ->check(CLI::IsMember({"real", "virtual"}))
-      ->capture_default_str();
-  CLI::Option* seed = test->add_option("--seed", args->seed, "Recorded in the report");
+  test->add_option(
+          "--time", args->time,
+          "Time of the fleets: real, or virtual (lock-step, as fast as the processes go unless --speed); "
+          "default: each topology's time.mode")
+      ->check(CLI::IsMember({"real", "virtual"}));
+  test->add_option("--speed", args->speed, "Virtual time: max, or simulated seconds per real second");
+  test->add_option(
+      "--capture", args->capture,
+      "Capture every bus to DIR/<file>-<bus>.log (candump log; in virtual time the timestamps are "
+      "simulated seconds, the same on every run)");
+  CLI::Option* seed = test->add_option(
+      "--seed", args->seed,
+      "Seed of the random draws of faults that give none (overrides time.seed); in the report");
   test->add_option(
       "--state-dir", args->state_dir,
       "Keep each fleet's state and logs here (default: a temporary folder, kept only on failure)");
@@ -61,9 +73,18 @@ void AddTestCommand(CLI::App& app, Cli& cli) {
       for (const auto& file : args->files)
         options.files.emplace_back(file);
       options.junit = args->junit;
-      options.time_mode = args->time;
-      if (seed->count() > 0) options.seed = args->seed;
+      options.time.mode = args->time;
+      if (!args->speed.empty()) {
+        try {
+          options.time.speed = fleet::ParseSpeed(args->speed);
+        } catch (const std::invalid_argument& e) {
+          std::cerr << "canfleet test: " << e.what() << '\n';
+          return kExitUsage;
+        }
+      }
+      if (seed->count() > 0) options.seed = args->seed;  // also seeds the faults that give none
       options.state_dir = args->state_dir;
+      options.capture = args->capture;
       options.node_binary = args->node_binary;
       options.ready_timeout = std::chrono::milliseconds(DurationMs(args->ready_timeout));
       options.log_level = args->log_level;

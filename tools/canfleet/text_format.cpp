@@ -143,7 +143,16 @@ std::string FormatRate(double value) {
 
 std::string FormatStatus(const control::Status& status) {
   std::string out = "topology " + (status.topology().empty() ? std::string("?") : status.topology()) +
-                    ", up " + FormatUptime(status.uptime_s()) + "\n\n";
+                    ", up " + FormatUptime(status.uptime_s());
+  if (status.virtual_time()) {
+    char factor[96];
+    std::snprintf(factor, sizeof factor, " (virtual time, %.1fx real time%s)", status.speed_factor(),
+                  status.speed() > 0
+                      ? (", paced at " + std::to_string(static_cast<int>(status.speed())) + "x").c_str()
+                      : ", as fast as possible");
+    out += factor;
+  }
+  out += "\n\n";
 
   Table buses({"BUS", "BITRATE", "LOAD", "FRAMES/S", "ERRORS/S", "FRAMES", "ERRORS", "PORTS"});
   for (std::size_t c = 1; c < 8; ++c)

@@ -3,6 +3,7 @@
 #include <memory>
 #include "telemetry/cli_options.hpp"
 
+#include "orchestrator/fleet/fleet_time.hpp"
 #include "orchestrator/fleet/run_fleet.hpp"
 #include "orchestrator/topology/topology_loader.hpp"
 #include "tools/canfleet/cli.hpp"
@@ -20,6 +21,8 @@ struct UpArgs {
   std::string log_level = "info";
   bool no_start = false;
   bool telemetry = true;
+  std::string time;   ///< "" = the topology's
+  std::string speed;  ///< "" = the topology's
   telemetry::DdsOptions dds;
 };
 
@@ -35,6 +38,15 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.no_start = args.no_start;
   options.telemetry = args.telemetry;
   options.dds = args.dds;
+  options.time.mode = args.time;
+  if (!args.speed.empty()) {
+    try {
+      options.time.speed = fleet::ParseSpeed(args.speed);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "canfleet up: " << e.what() << '\n';
+      return kExitUsage;
+    }
+  }
   return fleet::RunFleet(options);
 }
 
@@ -82,6 +94,15 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
   up->add_option("--log-level", args->log_level, "Orchestrator log level")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   up->add_flag("--no-start", args->no_start, "Start the buses but no node processes");
+  up->add_option(
+        "--time", args->time,
+        "real, or virtual: lock-step virtual time, the broker owns the clock (default: the topology's "
+        "time.mode)")
+      ->check(CLI::IsMember({"real", "virtual"}));
+  up->add_option(
+      "--speed", args->speed,
+      "Virtual time: max (as fast as the processes go) or simulated seconds per real second, e.g. 10 "
+      "(default: the topology's time.speed, else max)");
   up->add_flag("!--no-telemetry", args->telemetry, "Do not publish BusStats and FaultEvents over DDS");
   telemetry::AddDdsOptions(*up, args->dds, telemetry::DdsDiscovery::kMonitorsOnly);
   up->callback([&cli, args] { cli.action = [&cli, args] { return RunUp(cli.global, *args); }; });

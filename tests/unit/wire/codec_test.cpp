@@ -61,13 +61,16 @@ Bytes MixedStream() {
   w.AddNodeReply(node_reply);
   w.AddFrame(Frame("182#BB"), BusTime(7000));
   w.AddBitRate(250'000);
+  w.AddTimeGrant(7000, 7024);
+  w.AddTimeReached(7024, 500'000'000);
+  w.AddTimeReached(7024, std::nullopt);
   w.AddError("bye");
   return ToBytes(w.Bytes());
 }
 
 const std::vector<std::string> kMixedExpected = {
-    R"(Hello protocol_version: 3 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true bitrate: 125000)",
-    "HelloReply accepted: true protocol_version: 3 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
+    R"(Hello protocol_version: 4 bus: "can0" node_name: "quad-5" node_id: 5 role: ROLE_NODE tx_confirmations: true bitrate: 125000)",
+    "HelloReply accepted: true protocol_version: 4 bitrate: 500000 mode: BUS_MODE_PACED port_id: 3",
     "FrameBatch 123#DEADBEEF@1000 7FF#@2000 1FFFFFFF#0102030405060708@3000 701#R1@4000",
     "TxConfirm 185#01@4500",
     "FrameBatch 080#@5000",
@@ -79,6 +82,9 @@ const std::vector<std::string> kMixedExpected = {
     R"(NodeReply request_id: 7 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })",
     "FrameBatch 182#BB@7000",
     "BitRate 250000",
+    "TimeGrant 7000..7024",
+    "TimeReached 7024 next 500000000",
+    "TimeReached 7024 idle",
     "Error bye",
 };
 

@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "bus/wire/message_writer.hpp"
 #include "tests/unit/wire/wire_test_support.hpp"
 
 namespace canfleet::wire {
@@ -209,6 +210,33 @@ TEST(WireDecoder, BufferStaysBoundedByOneMessage) {
   auto space = decoder.WritableSpace(16);
   EXPECT_GE(space.size(), kMaxMessageSize);
   EXPECT_LE(space.size(), kMaxMessageSize + 64 * 1024);
+}
+
+}  // namespace
+}  // namespace canfleet::wire
+
+namespace canfleet::wire {
+namespace {
+
+using namespace test;
+
+// Virtual time (protocol 4): a grant that does not move time forward, or a reply whose next
+// deadline is not after the time reached, would stall or rewind a fleet's clock: refused.
+TEST(WireDecoder, ATimeGrantThatDoesNotMoveTimeForwardIsAnError) {
+  MessageWriter w;
+  w.AddTimeGrant(5000, 5000);
+  const DecodeOutcome out = DecodeAll(w.Bytes());
+  EXPECT_TRUE(out.failed);
+  EXPECT_EQ(out.error, "malformed message: TimeGrant until_ns 5000 not after now_ns 5000 (or negative)");
+}
+
+TEST(WireDecoder, ATimeReachedWhoseNextDeadlineIsNotLaterIsAnError) {
+  MessageWriter w;
+  w.AddTimeReached(5000, 4000);
+  const DecodeOutcome out = DecodeAll(w.Bytes());
+  EXPECT_TRUE(out.failed);
+  EXPECT_EQ(out.error,
+            "malformed message: TimeReached next_deadline_ns 4000 not after time_ns 5000 (or negative)");
 }
 
 }  // namespace

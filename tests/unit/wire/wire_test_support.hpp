@@ -63,6 +63,16 @@ inline std::string Describe(const Message& m) {
     case MessageType::kBitRate:
       out += " " + std::to_string(m.envelope.bit_rate().bitrate());
       break;
+    case MessageType::kTimeGrant:
+      out += " " + std::to_string(m.envelope.time_grant().now_ns()) + ".." +
+             std::to_string(m.envelope.time_grant().until_ns());
+      break;
+    case MessageType::kTimeReached:
+      out += " " + std::to_string(m.envelope.time_reached().time_ns()) +
+             (m.envelope.time_reached().has_deadline()
+                  ? " next " + std::to_string(m.envelope.time_reached().next_deadline_ns())
+                  : std::string(" idle"));
+      break;
   }
   return out;
 }

@@ -1,0 +1,68 @@
+#pragma once
+/// @file A node process's side of lock-step virtual time (orchestrator/broker/README.md "Virtual
+/// time"): its scheduler runs only when the broker grants time. Each BrokerClientPort of the process
+/// holds what the broker sends (frames, TX confirmations, controller events, node requests) until
+/// the TimeGrant that follows it; once every connected port has its grant, the client applies what
+/// they hold at the grant's time (port by port, in port order: a stated tie rule for the instant),
+/// runs the node's timers up to the grant's end, and each port answers TimeReached with the node's
+/// next deadline. A node that is not granted does not run: nothing happens to it in the meantime.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "clock/granted_scheduler.hpp"
+
+namespace canfleet {
+
+/// Implemented by a port in virtual time (BrokerClientPort's connection).
+class GrantedPort {
+ public:
+  virtual ~GrantedPort() = default;
+  /// Applies, in order, what the broker sent before its grant.
+  virtual void ApplyHeld() = 0;
+  /// Tells the broker the node reached `time`, with its next deadline, and sends what the node
+  /// sent meanwhile before it.
+  virtual void Reached(TimePoint time, std::optional<TimePoint> next_deadline) = 0;
+};
+
+class VirtualTimeClient {
+ public:
+  /// `clock_id` names the process on every port's Hello (its name and process id);
+  /// `port_count`: how many ports it attaches.
+  VirtualTimeClient(GrantedScheduler& scheduler, std::string clock_id, std::size_t port_count);
+
+  GrantedScheduler& scheduler() { return scheduler_; }
+  const std::string& clock_id() const { return clock_id_; }
+  std::size_t port_count() const { return ports_.size(); }
+
+  /// Port `index` is connected, the bus's time being `now`: the node's clock moves there (a node
+  /// joins a running bus at the bus's time; time never goes back).
+  void Connected(std::size_t index, GrantedPort& port, TimePoint now);
+  /// Port `index` lost its connection: the others no longer wait for its grants.
+  void Disconnected(std::size_t index);
+  /// Port `index` got TimeGrant{now, until}. Runs the node once every connected port has one.
+  void Granted(std::size_t index, TimePoint now, TimePoint until);
+
+  /// Grants run so far (tests, statistics).
+  std::uint64_t Rounds() const { return rounds_; }
+
+ private:
+  struct Slot {
+    GrantedPort* port = nullptr;  ///< while connected
+    std::optional<TimePoint> now;
+    std::optional<TimePoint> until;
+  };
+  void RunIfAllGranted();
+
+  GrantedScheduler& scheduler_;
+  std::string clock_id_;
+  std::vector<Slot> ports_;
+  std::uint64_t rounds_ = 0;
+  bool running_ = false;  ///< a port failing while the node runs must not start another run
+  bool mismatch_logged_ = false;
+};
+
+}  // namespace canfleet

@@ -1,0 +1,305 @@
+#include "orchestrator/transport/time_conductor.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <asio/post.hpp>
+
+namespace canfleet::transport {
+
+namespace {
+
+std::string TimeText(TimePoint t) {
+  return std::to_string(std::chrono::duration<double>(t.time_since_epoch()).count()) + " s";
+}
+
+/// Rounds run one after another in one handler before the event loop gets a turn (other
+/// sessions, control requests): enough to amortise the turn, few enough to stay responsive.
+constexpr int kRoundsPerTurn = 64;
+
+}  // namespace
+
+TimeConductor::TimeConductor(asio::io_context& io, GrantedScheduler& scheduler, broker::Broker& broker,
+                             TimeConductorOptions options)
+    : io_(io),
+      scheduler_(scheduler),
+      broker_(broker),
+      options_(options),
+      grace_timer_(io),
+      pace_timer_(io),
+      join_timer_(io) {}
+
+TimeConductor::~TimeConductor() {
+  alive_.reset();
+  grace_timer_.cancel();
+  pace_timer_.cancel();
+  join_timer_.cancel();
+}
+
+void TimeConductor::Join(GrantedSession& session, const std::string& clock_id) {
+  Participant& p = participants_[clock_id];
+  p.clock_id = clock_id;
+  p.sessions.push_back(&session);
+  p.pending = true;  // it may act now (boot-up): it takes part in the next round
+  sessions_[&session] = SessionState{&p, false};
+  spdlog::debug("virtual time: {} joined at {} ({})", session.Label(), TimeText(Now()), clock_id);
+  if (join_target_ && participants_.size() >= *join_target_) {
+    spdlog::info("virtual time: {} node process(es) joined; time starts at {}", participants_.size(),
+                 TimeText(Now()));
+    join_target_.reset();
+    join_timer_.cancel();
+    Release();
+  }
+  Kick();
+}
+
+void TimeConductor::Leave(GrantedSession& session) {
+  auto it = sessions_.find(&session);
+  if (it == sessions_.end()) return;
+  Participant* p = it->second.participant;
+  const bool was_granted = it->second.granted;
+  sessions_.erase(it);
+  std::erase(p->sessions, &session);
+  if (!advancing_) Prune();
+  if (was_granted && --outstanding_ == 0 && round_open_) {
+    // Not from inside the session's own Close: close the round from the event loop.
+    asio::post(io_, [this, alive = std::weak_ptr<int>(alive_)] {
+      if (!alive.expired() && round_open_ && outstanding_ == 0) CloseRound();
+    });
+  }
+}
+
+void TimeConductor::Prune() {
+  for (auto it = participants_.begin(); it != participants_.end();) {
+    if (!it->second.sessions.empty()) {
+      ++it;
+      continue;
+    }
+    const Participant* gone = &it->second;
+    std::erase_if(submissions_, [gone](const Submission& s) { return s.participant == gone; });
+    it = participants_.erase(it);
+  }
+}
+
+void TimeConductor::Pending(GrantedSession& session) {
+  auto it = sessions_.find(&session);
+  if (it == sessions_.end()) return;
+  it->second.participant->pending = true;
+  Kick();
+}
+
+void TimeConductor::Submit(GrantedSession& session, broker::PortId port,
+                           std::span<const wire::StampedFrame> frames) {
+  auto it = sessions_.find(&session);
+  if (it == sessions_.end()) return;
+  for (const wire::StampedFrame& f : frames) {
+    submissions_.push_back(
+        {TimePoint(f.time), it->second.participant, &session.Bus(), next_sequence_++, port, f.frame});
+  }
+}
+
+bool TimeConductor::Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline) {
+  auto it = sessions_.find(&session);
+  if (it == sessions_.end() || !it->second.granted || !round_open_ || time != round_until_) return false;
+  it->second.granted = false;
+  it->second.participant->next = next_deadline;
+  if (--outstanding_ == 0 && !granting_) CloseRound();  // while granting, OpenRound closes it
+  return true;
+}
+
+void TimeConductor::AtBoundary(std::function<void()> action) {
+  if (!round_open_ && !advancing_) {
+    action();
+    Kick();
+    return;
+  }
+  boundary_.push_back(std::move(action));
+}
+
+void TimeConductor::Hold() {
+  ++holds_;
+}
+
+void TimeConductor::Release() {
+  if (holds_ > 0 && --holds_ == 0) Kick();
+}
+
+void TimeConductor::HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout) {
+  if (processes == 0 || participants_.size() >= processes) return;
+  Hold();
+  join_target_ = processes;
+  join_timer_.expires_after(timeout);
+  join_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_), timeout](const asio::error_code& ec) {
+    if (ec || alive.expired() || !join_target_) return;
+    spdlog::warn("virtual time: {} of {} node processes joined within {} ms (real time); time starts anyway",
+                 participants_.size(), *join_target_, timeout.count());
+    join_target_.reset();
+    Release();
+  });
+}
+
+double TimeConductor::Factor() const {
+  const double wall = std::chrono::duration<double>(stats_.wall).count();
+  return wall > 0 ? std::chrono::duration<double>(stats_.simulated).count() / wall : 0.0;
+}
+
+void TimeConductor::Kick() {
+  if (round_open_ || advancing_ || start_posted_ || pacing_) return;
+  start_posted_ = true;
+  asio::post(io_, [this, alive = std::weak_ptr<int>(alive_)] {
+    if (alive.expired()) return;
+    start_posted_ = false;
+    StartRound();
+  });
+}
+
+void TimeConductor::RunBoundaryActions() {
+  while (!boundary_.empty()) {
+    auto action = std::move(boundary_.front());
+    boundary_.pop_front();
+    action();
+  }
+}
+
+void TimeConductor::StartRound() {
+  for (int i = 0; i < kRoundsPerTurn; ++i) {
+    if (round_open_ || advancing_) return;
+    RunBoundaryActions();
+    if (!OpenRound()) return;
+    if (round_open_) return;  // waiting for TimeReached; CloseRound kicks the next one
+  }
+  Kick();  // rounds without node processes: let the event loop have a turn
+}
+
+bool TimeConductor::OpenRound() {
+  const TimePoint now = Now();
+  // Broker timers armed at the current time (a frame submitted between rounds) run first.
+  if (auto b = scheduler_.NextDeadline(); b && *b <= now) AdvanceBroker(now);
+
+  std::optional<TimePoint> node_next;
+  for (const auto& [id, p] : participants_) {
+    std::optional<TimePoint> t = p.pending ? std::optional(now) : p.next;
+    if (t && (!node_next || *t < *node_next)) node_next = t;
+  }
+  const std::optional<TimePoint> broker_next = scheduler_.NextDeadline();
+  if (holds_ > 0 || participants_.empty() || (!node_next && !broker_next)) {
+    run_wall_start_.reset();  // time stands still: pacing and the factor start again
+    return false;
+  }
+  TimePoint until = broker_next ? *broker_next : TimePoint::max();
+  if (node_next) until = std::min(until, *node_next + kLookahead);
+  if (until <= now) until = now + Duration(1);
+
+  const auto wall_now = std::chrono::steady_clock::now();
+  if (!run_wall_start_) {
+    run_wall_start_ = wall_now;
+    run_sim_start_ = now;
+    last_wall_ = wall_now;
+  }
+  if (options_.speed > 0) {
+    const auto due =
+        *run_wall_start_ +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(
+            std::chrono::duration<double>(until - run_sim_start_).count() / options_.speed));
+    if (due > wall_now) {
+      pacing_ = true;
+      pace_timer_.expires_at(due);
+      pace_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec) {
+        if (ec || alive.expired()) return;
+        pacing_ = false;
+        last_wall_ = std::chrono::steady_clock::now();  // waiting is not running
+        StartRound();
+      });
+      stats_.wall += wall_now - last_wall_;
+      return false;
+    }
+  }
+
+  round_open_ = true;
+  round_until_ = until;
+  outstanding_ = 0;
+  for (auto& [id, p] : participants_) {
+    if (!p.pending && !(p.next && *p.next <= until)) continue;
+    p.pending = false;
+    for (GrantedSession* s : p.sessions) {
+      sessions_[s].granted = true;
+      ++outstanding_;
+    }
+  }
+  // Granted after marking: a session failing in SendGrant leaves with its grant counted.
+  std::vector<GrantedSession*> granted;
+  for (auto& [s, state] : sessions_)
+    if (state.granted) granted.push_back(const_cast<GrantedSession*>(s));
+  std::sort(granted.begin(), granted.end(), [this](GrantedSession* a, GrantedSession* b) {
+    const auto& pa = sessions_[a].participant->clock_id;
+    const auto& pb = sessions_[b].participant->clock_id;
+    return pa != pb ? pa < pb : a->Bus() < b->Bus();
+  });
+  stats_.grants += granted.size();
+  granting_ = true;
+  for (GrantedSession* s : granted)
+    if (sessions_.contains(s)) s->SendGrant(now, until);
+  granting_ = false;
+  if (outstanding_ == 0) {
+    CloseRound();
+    return true;
+  }
+  grace_timer_.expires_after(options_.grace);
+  grace_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec) {
+    if (!ec && !alive.expired()) OnGraceExpired();
+  });
+  return true;
+}
+
+void TimeConductor::CloseRound() {
+  round_open_ = false;
+  grace_timer_.cancel();
+  AdvanceBroker(round_until_);
+  ++stats_.rounds;
+  const auto wall_now = std::chrono::steady_clock::now();
+  stats_.wall += wall_now - last_wall_;
+  last_wall_ = wall_now;
+  Kick();
+}
+
+void TimeConductor::AdvanceBroker(TimePoint until) {
+  advancing_ = true;
+  struct Done {
+    bool& flag;
+    ~Done() { flag = false; }
+  } done{advancing_};
+  const TimePoint start = Now();
+  std::stable_sort(submissions_.begin(), submissions_.end(), [](const Submission& a, const Submission& b) {
+    if (a.time != b.time) return a.time < b.time;
+    if (a.participant != b.participant) return a.participant->clock_id < b.participant->clock_id;
+    if (*a.bus_key != *b.bus_key) return *a.bus_key < *b.bus_key;
+    return a.sequence < b.sequence;
+  });
+  std::size_t taken = 0;
+  for (; taken < submissions_.size() && submissions_[taken].time <= until; ++taken) {
+    const Submission& s = submissions_[taken];
+    if (s.time < Now()) ++stats_.late_frames;
+    scheduler_.AdvanceTo(s.time);  // a time in the past is now
+    broker_.Submit(s.port, s.frame);
+    ++stats_.frames;
+  }
+  submissions_.erase(submissions_.begin(), submissions_.begin() + static_cast<std::ptrdiff_t>(taken));
+  scheduler_.AdvanceTo(until);
+  stats_.simulated += Now() - start;
+  Prune();  // processes that left meanwhile
+}
+
+void TimeConductor::OnGraceExpired() {
+  if (!round_open_) return;
+  std::vector<GrantedSession*> late;
+  for (auto& [s, state] : sessions_)
+    if (state.granted) late.push_back(const_cast<GrantedSession*>(s));
+  for (GrantedSession* s : late) {
+    ++stats_.evictions;
+    s->Evict("no TimeReached within " + std::to_string(options_.grace.count()) +
+             " ms (real time) of the grant to " + TimeText(round_until_) +
+             ": treated as disconnected, the bus's time goes on");
+  }
+}
+
+}  // namespace canfleet::transport

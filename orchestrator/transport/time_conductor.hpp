@@ -1,0 +1,188 @@
+#pragma once
+/// @file Lock-step virtual time on the broker's side (design decision 10, README of
+/// orchestrator/broker, "Virtual time"): the broker owns the clock of its buses and grants time to
+/// the node processes, so that a fleet runs deterministically and as fast as its processes go.
+///
+/// The scheme is conservative (ns-3's global next-event bound, FMI-LS-BUS), in rounds. Between
+/// rounds every node process and the broker stand at the same time T, with everything due by T
+/// done. A round:
+///   1. A = the earliest time a node can act: T if something was sent to it at T (frames that
+///      ended at T, a controller event, a node request, its HelloReply), else its next deadline.
+///      B = the broker's next deadline (the end of the frame on the wire, a fault's or a
+///      scenario's timer...).
+///   2. G = min(B, A + L), where L = kLookahead is the shortest time from a frame's submission to
+///      anything another node can see of it (the shortest transfer attempt on a bus at 1 Mbit/s).
+///      Nothing the nodes do in (T, G] can reach a node before G.
+///   3. Every node process with something at T or a deadline by G is granted G (TimeGrant); the
+///      others stand still, which is the same as running with nothing to do. Each answers
+///      TimeReached with its next deadline, after the frames it sent, stamped with their times.
+///   4. The broker runs its scheduler up to G, putting each node's frame on its bus at the frame's
+///      time (ties: by time, then node process name, bus and order sent), so arbitration, error
+///      counters and faults are those of real time; frames end at their exact times, and those
+///      ending at G go to their receivers, held for the next round.
+/// Outside inputs (control requests, new connections) are applied between rounds: at T, never
+/// inside a round. Time stands still while no node process takes part, and while Hold()s last.
+///
+/// Threading: the thread of the broker's event loop, like the broker.
+
+#include <asio/io_context.hpp>
+#include <asio/steady_timer.hpp>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "bus/wire/frame_record.hpp"
+#include "clock/granted_scheduler.hpp"
+#include "orchestrator/broker/broker.hpp"
+
+namespace canfleet::transport {
+
+/// A connection in virtual time, as the conductor sees it (NodeSession).
+class GrantedSession {
+ public:
+  virtual ~GrantedSession() = default;
+  /// Sends TimeGrant{now, until} after whatever was sent to the node since its last grant.
+  virtual void SendGrant(TimePoint now, TimePoint until) = 0;
+  /// The node did not answer in time: close the connection, saying why.
+  virtual void Evict(const std::string& reason) = 0;
+  /// For logs: "session 3 [quad-5 on can0, port 7]".
+  virtual const std::string& Label() const = 0;
+  /// The bus it is attached to (orders simultaneous frames of one process's ports).
+  virtual const std::string& Bus() const = 0;
+};
+
+struct TimeConductorOptions {
+  /// Simulated seconds per real second; 0: as fast as the processes go ("--speed max").
+  double speed = 0;
+  /// A node process that has not answered a grant within this (real time) is treated as
+  /// disconnected, so a killed or stalled process does not stop the fleet's time.
+  std::chrono::milliseconds grace{10'000};
+};
+
+struct TimeConductorStats {
+  std::uint64_t rounds = 0;               ///< rounds run (with or without node processes)
+  std::uint64_t grants = 0;               ///< TimeGrants sent
+  std::uint64_t frames = 0;               ///< node frames put on the buses at their times
+  std::uint64_t evictions = 0;            ///< sessions closed for not answering in time
+  std::uint64_t late_frames = 0;          ///< frames stamped before the bus's time (applied at it)
+  std::chrono::nanoseconds wall{0};       ///< real time spent running (not held, not idle)
+  std::chrono::nanoseconds simulated{0};  ///< simulated time run meanwhile
+};
+
+class TimeConductor {
+ public:
+  /// Shortest time from a submission to anything another port can see: a transfer attempt
+  /// destroyed after kRateErrorAttemptBits (24) bit times at 1 Mbit/s, the fastest rate a port
+  /// may run at. Shorter frames do not exist on classical CAN.
+  static constexpr Duration kLookahead = std::chrono::microseconds(24);
+
+  TimeConductor(asio::io_context& io, GrantedScheduler& scheduler, broker::Broker& broker,
+                TimeConductorOptions options = {});
+  ~TimeConductor();
+  TimeConductor(const TimeConductor&) = delete;
+  TimeConductor& operator=(const TimeConductor&) = delete;
+
+  // --- sessions (NodeSession) ---
+  /// A node process's port joins at the current time (call it between rounds: from AtBoundary).
+  /// `clock_id` groups the ports of one process; it is granted on all of them together.
+  void Join(GrantedSession& session, const std::string& clock_id);
+  /// The session ends (disconnected, closed, evicted): its process is no longer waited for on it.
+  void Leave(GrantedSession& session);
+  /// Something was sent to the session's node at the current time: it takes part in the next round.
+  void Pending(GrantedSession& session);
+  /// Frames the node sent, stamped with their times: put on the bus at those times.
+  void Submit(GrantedSession& session, broker::PortId port, std::span<const wire::StampedFrame> frames);
+  /// TimeReached from the session's node. False on a protocol violation (not granted, another time).
+  bool Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline);
+  bool Participates(const GrantedSession& session) const { return sessions_.contains(&session); }
+
+  // --- outside inputs ---
+  /// Runs `action` at the current time between rounds: now if no round is open, else when the
+  /// open round ends.
+  void AtBoundary(std::function<void()> action);
+  /// Time stands still until as many Release() calls (the fleet holds it until its nodes joined).
+  void Hold();
+  void Release();
+  /// Holds time until `processes` node processes have joined (a fleet's nodes all start at the
+  /// same simulated time, whatever their real start-up order), or `timeout` of real time has
+  /// passed (then it says how many joined, and time goes on).
+  void HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout);
+
+  TimePoint Now() const { return scheduler_.Now(); }
+  /// Achieved factor (simulated / real time) while running; 0 before any round.
+  double Factor() const;
+  const TimeConductorStats& Stats() const { return stats_; }
+  double Speed() const { return options_.speed; }
+
+ private:
+  struct Participant {
+    std::string clock_id;
+    std::vector<GrantedSession*> sessions;
+    std::optional<TimePoint> next;  ///< its next deadline, as last reported
+    bool pending = false;           ///< something was sent to it at the current time
+  };
+  struct SessionState {
+    Participant* participant = nullptr;
+    bool granted = false;  ///< granted in the open round and not answered yet
+  };
+  struct Submission {
+    TimePoint time;
+    const Participant* participant;
+    const std::string* bus_key;
+    std::uint64_t sequence;
+    broker::PortId port;
+    CanFrame frame;
+  };
+
+  void Kick();
+  void StartRound();
+  /// Opens a round to G; false when nothing is due (idle) or pacing delays it.
+  bool OpenRound();
+  void CloseRound();
+  void AdvanceBroker(TimePoint until);
+  void RunBoundaryActions();
+  /// Forgets processes whose every session left (and the frames they still had to go).
+  void Prune();
+  void OnGraceExpired();
+
+  asio::io_context& io_;
+  GrantedScheduler& scheduler_;
+  broker::Broker& broker_;
+  TimeConductorOptions options_;
+  asio::steady_timer grace_timer_;
+  asio::steady_timer pace_timer_;
+  asio::steady_timer join_timer_;
+  std::optional<std::size_t> join_target_;  ///< HoldUntilJoined's count, while it holds
+
+  std::map<std::string, Participant> participants_;  ///< by clock id: stable nodes, ordered names
+  std::unordered_map<const GrantedSession*, SessionState> sessions_;
+  std::vector<Submission> submissions_;
+  std::uint64_t next_sequence_ = 0;
+  std::deque<std::function<void()>> boundary_;
+
+  bool round_open_ = false;
+  bool advancing_ = false;
+  bool granting_ = false;  ///< sending a round's grants (a reply may come from inside one)
+  bool start_posted_ = false;
+  bool pacing_ = false;
+  TimePoint round_until_{};
+  std::size_t outstanding_ = 0;
+  int holds_ = 0;
+
+  // Pacing and the achieved factor: real and simulated time since running started.
+  /// Running since (real, simulated); reset when time stood still (held, idle, no node).
+  std::optional<std::chrono::steady_clock::time_point> run_wall_start_;
+  TimePoint run_sim_start_{};
+  std::chrono::steady_clock::time_point last_wall_{};  ///< when the last round closed
+  TimeConductorStats stats_;
+  std::shared_ptr<int> alive_ = std::make_shared<int>(0);
+};
+
+}  // namespace canfleet::transport

@@ -1,0 +1,221 @@
+// The broker's side of lock-step virtual time (orchestrator/transport/time_conductor.hpp): rounds,
+// the lookahead bound, frames put on the bus at their stamped times, outside inputs between rounds,
+// and a node that stops answering. Fake node sessions on a real Broker; the event loop is polled,
+// never run against the clock (the grace test uses a grace of 0 ms).
+#include "orchestrator/transport/time_conductor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <asio/io_context.hpp>
+#include <string>
+#include <vector>
+
+#include "bus/physics/frame_timing.hpp"
+#include "tests/support/bus_probe.hpp"
+
+namespace canfleet::transport {
+namespace {
+
+using namespace std::chrono_literals;
+using canfleet::test::Frame;
+
+constexpr std::uint32_t kBitrate = 250'000;
+
+constexpr std::int64_t Ns(Duration d) {
+  return d.count();
+}
+constexpr std::int64_t L = Ns(TimeConductor::kLookahead);
+
+/// A node process with one port, as its NodeSession would present it to the conductor.
+class FakeNode final : public GrantedSession, public broker::PortSink {
+ public:
+  FakeNode(std::string name, TimeConductor& conductor, broker::Broker& broker)
+      : name_(std::move(name)), conductor_(conductor), broker_(broker) {
+    port = broker_.Attach("can0", name_, *this);
+    conductor_.Join(*this, name_);
+  }
+  ~FakeNode() override { Leave(); }
+
+  // GrantedSession
+  void SendGrant(TimePoint now, TimePoint until) override {
+    grants.push_back({Ns(now.time_since_epoch()), Ns(until.time_since_epoch())});
+    if (answer_at_once) {
+      answer_at_once = false;
+      Reach(until.time_since_epoch() + answer_period);
+    }
+  }
+  void Evict(const std::string& reason) override {
+    evicted = reason;
+    Leave();
+  }
+  const std::string& Label() const override { return name_; }
+  const std::string& Bus() const override { return bus_; }
+
+  // PortSink
+  void Deliver(std::span<const broker::TimedFrame> frames) override {
+    for (const auto& f : frames)
+      received.push_back(ToCandump(f.frame) + "@" + std::to_string(Ns(f.time)));
+    conductor_.Pending(*this);
+  }
+  void ControllerChanged(const ControllerEvent&) override { conductor_.Pending(*this); }
+
+  /// Answers the last grant as the node would: frames sent during it, then TimeReached.
+  bool Reach(std::optional<Duration> next, std::vector<wire::StampedFrame> frames = {}) {
+    if (!frames.empty()) conductor_.Submit(*this, port, frames);
+    const TimePoint until(Duration(grants.back().second));
+    return conductor_.Reached(*this, until, next ? std::optional(TimePoint(*next)) : std::nullopt);
+  }
+  void Leave() {
+    if (left_) return;
+    left_ = true;
+    conductor_.Leave(*this);
+    broker_.Detach(port);
+  }
+
+  broker::PortId port = 0;
+  std::vector<std::pair<std::int64_t, std::int64_t>> grants;  ///< (now, until) in ns
+  std::vector<std::string> received;
+  std::string evicted;
+  /// Answers the next grant from inside SendGrant, its next deadline `answer_period` after the grant.
+  bool answer_at_once = false;
+  Duration answer_period = 500ms;
+
+ private:
+  std::string name_;
+  std::string bus_ = "can0";
+  TimeConductor& conductor_;
+  broker::Broker& broker_;
+  bool left_ = false;
+};
+
+class Conductor : public ::testing::Test {
+ protected:
+  Conductor() { broker.AddBus({.name = "can0", .bitrate = kBitrate}); }
+  /// Runs what the event loop has ready (posted rounds, expired zero-length timers).
+  void Poll() {
+    for (int i = 0; i < 100; ++i) {
+      io.restart();
+      if (io.poll() == 0) return;
+    }
+  }
+
+  asio::io_context io;
+  GrantedScheduler scheduler;
+  broker::Broker broker{scheduler};
+  TimeConductor conductor{io, scheduler, broker};
+};
+
+// A node that joins may act at once (boot-up): its first grant is to now + the lookahead; then it
+// leaps to its next deadline + the lookahead, whatever lies between.
+TEST_F(Conductor, ALoneNodeLeapsFromDeadlineToDeadline) {
+  FakeNode a("a", conductor, broker);
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u);
+  EXPECT_EQ(a.grants[0], std::make_pair(std::int64_t{0}, L));
+  ASSERT_TRUE(a.Reach(500ms));
+  Poll();
+  ASSERT_EQ(a.grants.size(), 2u);
+  EXPECT_EQ(a.grants[1], std::make_pair(L, Ns(500ms) + L));
+}
+
+// A frame a node sends during its grant goes on the bus at its stamped time and reaches the other
+// node at its end of frame, which is where the next round starts; that node is granted there.
+TEST_F(Conductor, AFrameGoesOnTheBusAtItsStampAndReachesTheOthersAtItsEndOfFrame) {
+  FakeNode a("a", conductor, broker), b("b", conductor, broker);
+  Poll();
+  ASSERT_TRUE(a.Reach(500ms));
+  ASSERT_TRUE(b.Reach(std::nullopt));  // b has nothing to do until it hears something
+  Poll();
+  ASSERT_EQ(a.grants.size(), 2u);
+  EXPECT_EQ(b.grants.size(), 1u) << "b has no deadline: it is not woken";
+  ASSERT_TRUE(a.Reach(1000ms, {{Frame("705#05"), 500ms}}));
+  Poll();
+  const std::int64_t end = Ns(500ms + BitTime(CountFrameBits(Frame("705#05")).total(), kBitrate));
+  EXPECT_EQ(b.received, (std::vector<std::string>{"705#05@" + std::to_string(end)}));
+  ASSERT_EQ(b.grants.size(), 2u);
+  EXPECT_EQ(b.grants[1], std::make_pair(end, end + L)) << "the frame ended at the round's start";
+}
+
+// A node whose deadline lies beyond the round is not woken; it keeps its place.
+TEST_F(Conductor, ANodeNotDueIsNotGranted) {
+  FakeNode a("a", conductor, broker), b("b", conductor, broker);
+  Poll();
+  ASSERT_TRUE(a.Reach(100ms));
+  ASSERT_TRUE(b.Reach(300ms));
+  Poll();
+  EXPECT_EQ(a.grants.back(), std::make_pair(L, Ns(100ms) + L));
+  EXPECT_EQ(b.grants.size(), 1u);
+  ASSERT_TRUE(a.Reach(400ms));
+  Poll();
+  EXPECT_EQ(b.grants.back(), std::make_pair(Ns(100ms) + L, Ns(300ms) + L));
+  EXPECT_EQ(a.grants.size(), 2u);
+}
+
+// Time stands still while held, and without any node; a hold's release lets it go on.
+TEST_F(Conductor, TimeStandsStillWhileHeldOrWithoutNodes) {
+  Poll();
+  EXPECT_EQ(conductor.Stats().rounds, 0u);
+  conductor.Hold();
+  FakeNode a("a", conductor, broker);
+  Poll();
+  EXPECT_TRUE(a.grants.empty());
+  conductor.Release();
+  Poll();
+  EXPECT_EQ(a.grants.size(), 1u);
+}
+
+// HoldUntilJoined: the fleet's nodes all start at the same simulated time.
+TEST_F(Conductor, HoldUntilJoinedStartsTimeWhenTheLastNodeJoins) {
+  conductor.HoldUntilJoined(2, std::chrono::milliseconds(60'000));
+  FakeNode a("a", conductor, broker);
+  Poll();
+  EXPECT_TRUE(a.grants.empty());
+  FakeNode b("b", conductor, broker);
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u);
+  ASSERT_EQ(b.grants.size(), 1u);
+  EXPECT_EQ(a.grants[0], b.grants[0]);
+}
+
+// An outside input (a control request) arriving while a round is open waits for its end.
+TEST_F(Conductor, AnOutsideInputWaitsForTheEndOfTheOpenRound) {
+  FakeNode a("a", conductor, broker);
+  Poll();
+  bool ran = false;
+  conductor.AtBoundary([&] { ran = true; });
+  EXPECT_FALSE(ran) << "a round is open";
+  ASSERT_TRUE(a.Reach(500ms));
+  Poll();
+  EXPECT_TRUE(ran);
+}
+
+// A node that does not answer within the grace is evicted, and time goes on for the others.
+TEST(ConductorGrace, ANodeThatStopsAnsweringIsEvictedAndTimeGoesOn) {
+  asio::io_context io;
+  GrantedScheduler scheduler;
+  broker::Broker broker{scheduler};
+  broker.AddBus({.name = "can0", .bitrate = kBitrate});
+  TimeConductor conductor{io, scheduler, broker, {.speed = 0, .grace = std::chrono::milliseconds(0)}};
+  FakeNode a("a", conductor, broker), b("b", conductor, broker);
+  a.answer_at_once = true;  // a answers its first grant; b never does
+  for (int i = 0; i < 10 && a.grants.size() < 2; ++i) {
+    io.restart();
+    io.poll();
+  }
+  EXPECT_NE(b.evicted.find("no TimeReached within 0 ms"), std::string::npos) << b.evicted;
+  ASSERT_GE(a.grants.size(), 2u) << "a's next deadline is granted without b";
+  EXPECT_EQ(a.grants[1].second, L + Ns(500ms) + L);
+  EXPECT_EQ(b.grants.size(), 1u);
+}
+
+// A reply that is not for the open round's time, or a second one, is refused.
+TEST_F(Conductor, AReplyForAnotherTimeIsRefused) {
+  FakeNode a("a", conductor, broker);
+  Poll();
+  EXPECT_FALSE(conductor.Reached(a, TimePoint(5ms), std::nullopt));
+  EXPECT_TRUE(a.Reach(std::nullopt));
+  EXPECT_FALSE(a.Reach(std::nullopt)) << "already answered";
+}
+
+}  // namespace
+}  // namespace canfleet::transport
