@@ -93,6 +93,8 @@ struct OrchestratorTelemetry::Impl {
       cob_ids[i] = {s.top_cob_ids[i].cob_id, s.top_cob_ids[i].frames_per_second};
     stats_sample.top_cob_ids._length = static_cast<std::uint32_t>(n);
     stats_sample.serial = ++bus.serial;
+    stats_sample.simulated_s = s.simulated_s;
+    stats_sample.speed_factor = s.speed_factor;
     Count(stats_writer.Write(stats_sample), state_writes);
   }
 

@@ -39,6 +39,8 @@ struct BusStatsSnapshot {
   std::uint16_t node_count = 0;
   std::uint8_t top_cob_id_count = 0;
   std::array<CobIdRate, kMaxTopCobIds> top_cob_ids{};
+  double simulated_s = 0;  ///< mode "virtual": simulated time of the bus
+  float speed_factor = 0;  ///< mode "virtual": simulated / real seconds achieved
 };
 
 /// True if the configuration or the error picture changed (bitrate, mode, node count, error

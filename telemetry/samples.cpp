@@ -223,6 +223,8 @@ BusStatsSample FromDds(const canfleet_telemetry_BusStats& s) {
     out.top_cob_ids.push_back({s.top_cob_ids._buffer[i].cob_id, s.top_cob_ids._buffer[i].frames_per_second});
   }
   out.serial = s.serial;
+  out.simulated_s = s.simulated_s;
+  out.speed_factor = s.speed_factor;
   return out;
 }
 

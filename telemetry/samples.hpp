@@ -77,6 +77,8 @@ struct BusStatsSample {
   std::uint16_t node_count = 0;
   std::vector<CobIdRate> top_cob_ids{};
   std::uint32_t serial = 0;
+  double simulated_s = 0;  ///< mode "virtual": simulated time of the bus
+  float speed_factor = 0;  ///< mode "virtual": simulated / real seconds achieved
 };
 
 struct FaultEventSample {

@@ -109,6 +109,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   ConnectionHandler on_connection;
   TxConfirmHandler on_tx_confirmed;
   NodeRequestHandler on_node_request;
+  AcceptanceProvider acceptance;
 
  private:
   enum class Phase : std::uint8_t { kIdle, kConnecting, kHandshake, kConnected, kWaiting, kStopped };
@@ -288,6 +289,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
       case wire::MessageType::kNodeReply:
       case wire::MessageType::kBitRate:
       case wire::MessageType::kTimeReached:
+      case wire::MessageType::kAcceptance:
         ProtocolError(std::string("unexpected ") + wire::ToString(m.type) + " from the broker");
         return;
     }
@@ -353,6 +355,14 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
 
   void Reached(TimePoint time, std::optional<TimePoint> next_deadline) override {
     if (phase_ != Phase::kConnected) return;
+    if (acceptance) {
+      auto ids = acceptance();
+      if (!acceptance_sent_ || ids != last_acceptance_) {
+        filling_.AddAcceptance(ids);
+        last_acceptance_ = std::move(ids);
+        acceptance_sent_ = true;
+      }
+    }
     filling_.AddTimeReached(
         time.time_since_epoch().count(),
         next_deadline ? std::optional(next_deadline->time_since_epoch().count()) : std::nullopt);
@@ -420,6 +430,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
                 reply.virtual_time()};
     held_.clear();
     held_requests_.clear();
+    acceptance_sent_ = false;  // a new attachment knows no filter
     if (options_.virtual_time) {
       const std::uint64_t gen_before = generation_;
       options_.virtual_time->Connected(options_.virtual_time_index, *this,
@@ -578,6 +589,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   };
   std::vector<Held> held_;
   std::vector<wire::NodeRequest> held_requests_;
+  /// The acceptance filter last sent on this connection.
+  std::optional<std::vector<std::uint32_t>> last_acceptance_;
+  bool acceptance_sent_ = false;
   BrokerSession session_;
   BrokerClientStats stats_;
 };
@@ -627,6 +641,10 @@ void BrokerClientPort::OnTxConfirmed(TxConfirmHandler handler) {
 
 void BrokerClientPort::OnNodeRequest(NodeRequestHandler handler) {
   link_->on_node_request = std::move(handler);
+}
+
+void BrokerClientPort::OnAcceptance(AcceptanceProvider provider) {
+  link_->acceptance = std::move(provider);
 }
 
 const BrokerClientStats& BrokerClientPort::Stats() const {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bus/broker_client/virtual_time_client.hpp"
 #include "bus/bus_port.hpp"
@@ -96,6 +97,9 @@ class BrokerClientPort final : public BusPort {
   /// Called on the io thread; the reply's request_id is filled in by the port. It may destroy the
   /// port (then nothing is sent).
   using NodeRequestHandler = std::function<wire::NodeReply(const wire::NodeRequest&)>;
+  /// Virtual time: the 11-bit identifiers the node listens to now (nullopt: every frame), asked at
+  /// the end of each grant; a change is sent to the broker (Acceptance) before TimeReached.
+  using AcceptanceProvider = std::function<std::optional<std::vector<std::uint32_t>>()>;
 
   /// Throws std::invalid_argument on a malformed endpoint.
   BrokerClientPort(asio::io_context& io, BrokerClientOptions options);
@@ -123,6 +127,7 @@ class BrokerClientPort final : public BusPort {
   /// Serves the broker's NodeRequests. Without a handler the port answers each with the error
   /// "<node name> serves no node requests", so the broker is not left waiting.
   void OnNodeRequest(NodeRequestHandler handler);
+  void OnAcceptance(AcceptanceProvider provider);
 
   const BrokerClientStats& Stats() const;
 

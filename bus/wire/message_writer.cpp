@@ -150,6 +150,14 @@ void MessageWriter::AddTimeReached(std::int64_t time_ns, std::optional<std::int6
   });
 }
 
+void MessageWriter::AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids) {
+  AppendProto([&](Envelope& e) {
+    auto* acceptance = e.mutable_acceptance();
+    acceptance->set_all(!ids.has_value());
+    if (ids) acceptance->mutable_ids()->Add(ids->begin(), ids->end());
+  });
+}
+
 void MessageWriter::Clear() {
   buffer_.clear();
   batch_open_ = false;

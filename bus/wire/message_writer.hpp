@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "bus/wire/byte_buffer.hpp"
 #include "bus/wire/messages.hpp"
@@ -95,6 +96,8 @@ class MessageWriter {
   void AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns);
   /// TimeReached{time_ns, next deadline} (virtual time, node -> broker); no deadline: nullopt.
   void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns);
+  /// Acceptance{ids} (virtual time, node -> broker); nullopt: every frame.
+  void AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids);
   /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write
   /// that went to the socket only in part), after closing the open batch.
   void AddEncoded(const std::uint8_t* bytes, std::size_t size);

@@ -32,6 +32,8 @@ const char* ToString(MessageType type) {
       return "TimeGrant";
     case MessageType::kTimeReached:
       return "TimeReached";
+    case MessageType::kAcceptance:
+      return "Acceptance";
   }
   return "unknown";
 }

@@ -22,7 +22,7 @@ namespace canfleet::wire {
 /// another version is refused with a reason naming both.
 /// 2: NodeRequest / NodeReply.
 /// 3: Hello.bitrate and BitRate (the node's controller bit rate).
-/// 4: virtual time (Hello.virtual_time, TimeGrant, TimeReached).
+/// 4: virtual time (Hello.virtual_time, TimeGrant, TimeReached, Acceptance).
 inline constexpr std::uint32_t kProtocolVersion = 4;
 
 /// Largest Envelope (without its length prefix). Longer = protocol error.
@@ -49,6 +49,7 @@ enum class MessageType : std::uint8_t {
   kBitRate,      ///< node -> broker: envelope.bit_rate()
   kTimeGrant,    ///< broker -> node (virtual time): envelope.time_grant()
   kTimeReached,  ///< node -> broker (virtual time): envelope.time_reached()
+  kAcceptance,   ///< node -> broker (virtual time): envelope.acceptance()
 };
 
 const char* ToString(MessageType type);

@@ -247,6 +247,21 @@ bool StreamDecoder::DecodeEnvelope(std::span<const std::uint8_t> body, Message& 
       out.type = MessageType::kTimeReached;
       return true;
     }
+    case Envelope::kAcceptance: {
+      const Acceptance& acceptance = out.envelope.acceptance();
+      if (acceptance.ids_size() > 2048) {
+        error_ = "Acceptance with " + std::to_string(acceptance.ids_size()) + " identifiers (at most 2048)";
+        return false;
+      }
+      for (const std::uint32_t id : acceptance.ids()) {
+        if (id > 0x7FF) {
+          error_ = "Acceptance identifier " + std::to_string(id) + " is not an 11-bit identifier";
+          return false;
+        }
+      }
+      out.type = MessageType::kAcceptance;
+      return true;
+    }
     case Envelope::BODY_NOT_SET:
       break;
   }

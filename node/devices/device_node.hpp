@@ -70,6 +70,12 @@ class DeviceNode {
   std::size_t PortCount() const { return stacks_.size(); }
   canopen::CanopenStack& stack(std::size_t port = 0) { return *stacks_.at(port); }
   canopen::ObjectDictionary& od(std::size_t port = 0) { return *dictionaries_.at(port); }
+  /// The 11-bit identifiers port `port` listens to now (canopen::CanopenStack::ListenedIds), or
+  /// nullopt when the device itself watches every frame of the port.
+  std::optional<std::vector<std::uint32_t>> ListenedIds(std::size_t port) const {
+    if (device_ports_.at(port)->Observed()) return std::nullopt;
+    return stacks_.at(port)->ListenedIds();
+  }
 
  private:
   void ShareObjects();

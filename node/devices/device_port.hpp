@@ -33,6 +33,8 @@ class DevicePort final : public BusPort {
   void SetMuted(bool muted) { muted_ = muted; }
   bool Muted() const { return muted_; }
   void ObserveFrames(FrameObserver observer) { observer_ = std::move(observer); }
+  /// The device watches every frame (a power supply wakes on any of them, §1.2.2).
+  bool Observed() const { return static_cast<bool>(observer_); }
 
  private:
   BusPort& port_;

@@ -175,10 +175,14 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   }
   if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options));
   // Remote I/O: the orchestrator sets and reads the simulated I/O over the broker connection.
-  for (auto& port : ports)
-    if (auto* client = dynamic_cast<BrokerClientPort*>(port.get()))
-      client->OnNodeRequest(
-          [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
+  for (std::size_t p = 0; p < port_count; ++p) {
+    auto* client = dynamic_cast<BrokerClientPort*>(ports[p].get());
+    if (client == nullptr) continue;
+    client->OnNodeRequest(
+        [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
+    // Virtual time: the broker wakes the node only for frames its stack listens to.
+    if (options.virtual_time) client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
+  }
   for (const auto& assignment : options.io) {
     auto eq = assignment.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("--io " + assignment + ": expected NAME=VALUE");

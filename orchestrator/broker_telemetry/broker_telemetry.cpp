@@ -65,7 +65,13 @@ void BrokerTelemetry::Sample() {
       seen.insert(bus);
       continue;
     }
-    publisher_.UpdateBusStats(ToSnapshot(broker_.Stats(bus, telemetry::kMaxTopCobIds)));
+    telemetry::BusStatsSnapshot snapshot = ToSnapshot(broker_.Stats(bus, telemetry::kMaxTopCobIds));
+    if (options_.virtual_time_factor) {
+      snapshot.mode = "virtual";
+      snapshot.simulated_s = std::chrono::duration<double>(scheduler_.Now().time_since_epoch()).count();
+      snapshot.speed_factor = static_cast<float>(options_.virtual_time_factor());
+    }
+    publisher_.UpdateBusStats(snapshot);
     published_.insert(bus);
     seen.insert(bus);
   }

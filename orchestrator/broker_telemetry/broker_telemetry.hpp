@@ -23,6 +23,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -42,6 +43,9 @@ struct BrokerTelemetryOptions {
   /// writes a bus's sample at once when its configuration or error count changed, and at least
   /// every OrchestratorTelemetryOptions::period.
   std::chrono::milliseconds period{1000};
+  /// Virtual time: the factor achieved so far (simulated / real seconds); the buses' mode is then
+  /// "virtual" and their samples carry simulated time. Unset: real time.
+  std::function<double()> virtual_time_factor{};
 };
 
 /// A fault as its injector describes it.

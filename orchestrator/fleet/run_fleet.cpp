@@ -35,11 +35,8 @@ void WriteStateFile(const std::filesystem::path& path, const std::string& contro
 
 }  // namespace
 
-std::size_t StartedProcesses(const topology::Topology& spec) {
-  std::size_t count = 0;
-  for (const auto& node : spec.node())
-    count += node.external() ? 0 : 1;
-  return count;
+std::size_t NodeProcesses(const topology::Topology& spec) {
+  return static_cast<std::size_t>(spec.node_size());
 }
 
 std::filesystem::path FindNodeBinary(const std::filesystem::path& asked) {
@@ -181,7 +178,7 @@ int RunFleet(const UpOptions& options) {
     spdlog::info("virtual time: {}", conductor->Speed() > 0
                                          ? "paced at " + std::to_string(conductor->Speed()) + "x real time"
                                          : std::string("as fast as the processes go"));
-    if (!options.no_start) conductor->HoldUntilJoined(StartedProcesses(spec), kJoinTimeout);
+    if (!options.no_start) conductor->HoldUntilJoined(NodeProcesses(spec), kJoinTimeout);
   }
   io.run();
   control_server.reset();

@@ -28,8 +28,9 @@ struct UpOptions {
   TimeOverride time;  ///< --time / --speed; empty: the topology's time
 };
 
-/// The node processes a fleet of `spec` starts itself (external nodes are started elsewhere).
-std::size_t StartedProcesses(const topology::Topology& spec);
+/// The node processes of a fleet of `spec`: one per node, started by the fleet or (external)
+/// elsewhere; in virtual time the fleet's time starts once all of them joined.
+std::size_t NodeProcesses(const topology::Topology& spec);
 
 /// canfleet-node: `asked` when given (it must be executable), else beside this executable, else on
 /// PATH. Throws std::runtime_error naming what was tried.

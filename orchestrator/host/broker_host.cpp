@@ -93,8 +93,10 @@ bool BrokerHost::StartTelemetry(const telemetry::DdsOptions& dds, std::chrono::m
   try {
     participant_.emplace(dds);
     publisher_.emplace(*participant_, telemetry::OrchestratorTelemetryOptions{.period = period});
-    bus_telemetry_.emplace(broker_, *scheduler_, *publisher_,
-                           broker::BrokerTelemetryOptions{.period = period});
+    broker::BrokerTelemetryOptions options;
+    options.period = period;
+    if (conductor_) options.virtual_time_factor = [c = conductor_.get()] { return c->Factor(); };
+    bus_telemetry_.emplace(broker_, *scheduler_, *publisher_, options);
     spdlog::info("telemetry on DDS domain {}", dds.domain_id);
     return true;
   } catch (const std::exception& e) {

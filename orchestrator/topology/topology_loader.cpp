@@ -109,7 +109,8 @@ class Loader {
                                                : facts_.Resolve(o.state_root());
   }
 
-  /// Virtual time needs paced buses (a time line) and nothing that lives in real time.
+  /// Virtual time needs paced buses (a time line) and nothing that lives in real time. An external
+  /// node joins as any other, started with `canfleet-node --time virtual` wherever it runs.
   void CheckTime(const Scope& root) {
     if (!spec_.has_time()) return;
     const Time& t = spec_.time();
@@ -124,11 +125,6 @@ class Loader {
       if (bus.socketcand_port() != 0)
         b.Fail("socketcand_port", "socketcand clients live in real time: not served in virtual time");
     }
-    for (int i = 0; i < spec_.node_size(); ++i)
-      if (spec_.node(i).external())
-        root.Child("node", spec_.node(i), i)
-            .Fail("external",
-                  "a node started elsewhere keeps real time: not part of a fleet in virtual time");
   }
 
   static void CheckEndpoint(const Scope& s, std::string_view field, int index, const std::string& text) {

@@ -182,6 +182,14 @@ void NodeSession::Handle(const wire::Message& m) {
                       " ns without a grant to that time");
       return;
     }
+    case MessageType::kAcceptance: {
+      const auto& acceptance = m.envelope.acceptance();
+      accept_all_ = acceptance.all();
+      accepted_.reset();
+      for (const std::uint32_t id : acceptance.ids())
+        accepted_.set(id);
+      return;
+    }
     case MessageType::kTimeGrant:
     case MessageType::kHelloReply:
     case MessageType::kTxConfirm:
@@ -419,6 +427,17 @@ void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
     stats_->backlog_drops += frames.size();
     return;
   }
+  if (granted_ && !accept_all_) {
+    // Virtual time: what the node does not listen to does not wake it.
+    std::size_t accepted = 0;
+    for (const broker::TimedFrame& f : frames) {
+      if (!Accepts(f.frame)) continue;
+      filling_.AddFrame(f.frame, f.time);
+      ++accepted;
+    }
+    if (accepted > 0) Queued();
+    return;
+  }
   filling_.AddFrames(wire::MessageType::kFrames, frames, Stamped);
   Queued();
 }
@@ -434,6 +453,20 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
+  if (granted_ && !accept_all_) {
+    // Virtual time: what the node does not listen to does not wake it.
+    const std::span<const broker::TimedFrame> all = round.Frames();
+    std::size_t accepted = 0;
+    for (const broker::FrameRun& run : runs) {
+      for (std::uint32_t i = run.begin; i < run.end; ++i) {
+        if (!Accepts(all[i].frame)) continue;
+        filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{i} * wire::kFrameRecordSize, 1);
+        ++accepted;
+      }
+    }
+    if (accepted > 0) Queued();
+    return;
+  }
   // In virtual time the grant that follows sends the frames: frames and grant in one write.
   if (!granted_ && !write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&
       frames <= wire::kMaxFramesPerMessage) {

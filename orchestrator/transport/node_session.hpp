@@ -6,6 +6,7 @@
 
 #include <sys/uio.h>
 #include <array>
+#include <bitset>
 
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/steady_timer.hpp>
@@ -137,6 +138,13 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   bool closed_ = false;
   bool hello_seen_ = false;  ///< a Hello arrived (in virtual time it is accepted between rounds)
   bool granted_ = false;     ///< a node in virtual time: the conductor grants its time
+  /// Virtual time: the node's acceptance filter (Acceptance); until it sends one, every frame.
+  bool accept_all_ = true;
+  std::bitset<2048> accepted_;
+  /// Whether `frame` passes the filter (extended and error frames always do).
+  bool Accepts(const CanFrame& frame) const {
+    return accept_all_ || frame.extended() || frame.error() || accepted_.test(frame.id & 0x7FF);
+  }
 
   wire::StreamDecoder decoder_;
   wire::Message message_;

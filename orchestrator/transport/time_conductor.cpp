@@ -244,16 +244,31 @@ bool TimeConductor::OpenRound() {
     CloseRound();
     return true;
   }
-  grace_timer_.expires_after(options_.grace);
-  grace_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec) {
-    if (!ec && !alive.expired()) OnGraceExpired();
-  });
+  // One OS timer for many rounds: armed only when none is pending (re-arming it for every round
+  // of a few microseconds cost two timerfd syscalls each); it checks the open round's age.
+  round_opened_ = std::chrono::steady_clock::now();
+  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
   return true;
+}
+
+void TimeConductor::ArmGrace(std::chrono::steady_clock::time_point at) {
+  grace_armed_ = true;
+  grace_timer_.expires_at(at);
+  grace_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec) {
+    if (ec || alive.expired()) return;
+    grace_armed_ = false;
+    if (!round_open_) return;  // the next round arms it again
+    const auto due = round_opened_ + options_.grace;
+    if (std::chrono::steady_clock::now() < due) {
+      ArmGrace(due);  // a younger round than the one it was armed for
+      return;
+    }
+    OnGraceExpired();
+  });
 }
 
 void TimeConductor::CloseRound() {
   round_open_ = false;
-  grace_timer_.cancel();
   AdvanceBroker(round_until_);
   ++stats_.rounds;
   const auto wall_now = std::chrono::steady_clock::now();

@@ -151,12 +151,16 @@ class TimeConductor {
   /// Forgets processes whose every session left (and the frames they still had to go).
   void Prune();
   void OnGraceExpired();
+  /// The grace timer, for the open round's deadline `at` (real time).
+  void ArmGrace(std::chrono::steady_clock::time_point at);
 
   asio::io_context& io_;
   GrantedScheduler& scheduler_;
   broker::Broker& broker_;
   TimeConductorOptions options_;
   asio::steady_timer grace_timer_;
+  bool grace_armed_ = false;
+  std::chrono::steady_clock::time_point round_opened_{};  ///< real time the open round began
   asio::steady_timer pace_timer_;
   asio::steady_timer join_timer_;
   std::optional<std::size_t> join_target_;  ///< HoldUntilJoined's count, while it holds

@@ -38,6 +38,9 @@
 #       1016h sub 1 = 000705DCh, 1017h = 500 read back); after a disconnect the same process is back,
 #       having itself lost quad-7's heartbeat (its own EMCY, pre-operational); after
 #       `canfleet nmt start` every node is operational again
+#  5. virtual time: quad-5 in a container of its own joins a `canfleet up --time virtual` fleet (in a
+#     container) as an external node started with `canfleet-node --time virtual`; configured over the
+#     bus, its heartbeat loss gives quad-6 EMCY 8130h and 1003h = 08058130h as in real time
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/../.." && pwd)"
 cd "$repo"
@@ -140,6 +143,8 @@ teardown() {
       fleet compose logs --no-color --tail 60 orchestrator 2>&1 | sed 's/^/  /' || true
     fi
     fleet down >/dev/null 2>&1 || log "WARNING: 'compose down' of $CANFLEET_PROJECT failed"
+    docker rm -f "$CANFLEET_PROJECT-vt-orchestrator" "$CANFLEET_PROJECT-vt-quad-5" >/dev/null 2>&1 || true
+    if [ -n "${vt_dir:-}" ]; then rm -rf "$vt_dir"; fi
     log "fleet $CANFLEET_PROJECT removed"
   fi
   if [ "$rc" = 0 ]; then
@@ -350,6 +355,71 @@ loss_and_back() { # METHOD: stop | kill | disconnect
 loss_and_back stop
 loss_and_back kill
 loss_and_back disconnect
+
+# ---- 5. virtual time: a node in a container joins a fleet in lock-step virtual time ---------------
+# `canfleet up --time virtual` in a container (the orchestrator starts quad-6 itself) and quad-5 as an
+# external node in a container of its own, `canfleet-node --time virtual`: the same protocol as a
+# local node (orchestrator/broker/README.md "Virtual time"). Both share the host's network stack
+# (--network host), so the broker stays on loopback. The fleet's time starts once both joined; the
+# orchestrator configures quad-5 over the bus; a heartbeat loss of quad-5 is served at the current
+# simulated time and quad-6 reports it as in real time (Quad manual §4.1: EMCY 8130h, 1003h sub 1 =
+# 08058130h).
+virtual_time_in_containers() {
+  local t control broker
+  t=$(date +%s)
+  vt_dir=$(mktemp -d /tmp/canfleet-docker-vt-XXXXXX)
+  read -r control broker < <(python3 -c '
+import socket
+socks = [socket.socket() for _ in range(2)]
+for s in socks: s.bind(("127.0.0.1", 0))
+print(*[s.getsockname()[1] for s in socks])')
+  cat >"$vt_dir/vt.textproto" <<TOPOLOGY
+name: "docker-virtual-time"
+time { mode: VIRTUAL speed: 20 }
+bus { name: "can0" bitrate: 250000 }
+node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" external: true
+       heartbeat { producer_ms: 200 } }
+node { name: "quad-6" device: "quad-controller" node_id: 6 bus: "can0"
+       heartbeat { producer_ms: 200 consumer { node: "quad-5" timeout_ms: 1000 } } }
+TOPOLOGY
+  docker run -d --name "$CANFLEET_PROJECT-vt-orchestrator" --network host -v "$vt_dir:/vt" "$CANFLEET_IMAGE" \
+    canfleet up /vt/vt.textproto --control "tcp://127.0.0.1:$control" --listen "tcp://127.0.0.1:$broker" \
+    --no-telemetry >/dev/null || fail "virtual time: the orchestrator container did not start"
+  docker run -d --name "$CANFLEET_PROJECT-vt-quad-5" --network host "$CANFLEET_IMAGE" \
+    canfleet-node --time virtual --device quad-controller --node-id 5 --name quad-5 \
+    --bus "can0@tcp://127.0.0.1:$broker" --no-telemetry >/dev/null ||
+    fail "virtual time: the quad-5 container did not start"
+  vt_cli() { docker run --rm --network host "$CANFLEET_IMAGE" canfleet --control "tcp://127.0.0.1:$control" "$@"; }
+  vt_get() { # NODE FIELD (NODE "-" and FIELD virtual_time: the fleet's)
+    vt_cli status --json | python3 -c '
+import json, sys
+s = json.load(sys.stdin)
+if sys.argv[2] == "virtual_time":
+    print(str(s.get("virtual_time", False)).lower()); sys.exit(0)
+for n in s["nodes"]:
+    if n["name"] == sys.argv[1]:
+        v = n
+        for part in sys.argv[2].split("."):
+            v = v.get(part, "") if isinstance(v, dict) else ""
+        print(v); sys.exit(0)
+sys.exit(1)' "$1" "$2"
+  }
+  vt_is() { [ "$(vt_get "$1" "$2")" = "$3" ]; }
+  wait_for 120 "virtual time: quad-5 (its own container) operational" vt_is quad-5 nmt_state operational
+  wait_for 60 "virtual time: quad-6 operational" vt_is quad-6 nmt_state operational
+  vt_is - virtual_time true || fail "virtual time: canfleet status does not say the fleet runs in virtual time"
+  docker logs "$CANFLEET_PROJECT-vt-quad-5" 2>&1 | grep -q "virtual time" ||
+    fail "virtual time: quad-5's log does not show a connection in virtual time"
+  expect_eq "virtual time: quad-5 1017h (set by the orchestrator over the bus)" \
+    "$(vt_cli sdo read quad-5 0x1017 0 u16)" 200
+  vt_cli fault inject heartbeat-loss --node quad-5 >/dev/null || fail "virtual time: fault inject refused"
+  wait_for 60 "virtual time: quad-6 EMCY 8130h after quad-5's heartbeat loss" \
+    vt_is quad-6 last_emcy.code 33072
+  expect_eq "virtual time: quad-6 1003h sub 1" "$(vt_cli sdo read quad-6 0x1003 1 u32)" 0x08058130
+  pass "virtual time: quad-5 in a container joined a fleet in lock-step virtual time, configured over the bus (1017h = 200); its heartbeat loss gave quad-6 EMCY 8130h and 1003h = 08058130h ($(elapsed "$t"))"
+  docker rm -f "$CANFLEET_PROJECT-vt-orchestrator" "$CANFLEET_PROJECT-vt-quad-5" >/dev/null 2>&1 || true
+}
+virtual_time_in_containers
 
 log "checked:"
 for c in "${checks[@]}"; do echo "docker-test:   - $c"; done

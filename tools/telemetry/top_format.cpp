@@ -163,6 +163,8 @@ std::string BusLine(const std::string& name, const BusRow& bus, int node_count) 
         Printf(" %5u kbit/s %-9.9s load %5.1f%%  %7.0f fr/s  err %llu  ports %u", s.bitrate / 1000,
                s.mode.c_str(), static_cast<double>(s.load_percent), static_cast<double>(s.frames_per_second),
                static_cast<unsigned long long>(s.error_frames), s.node_count);
+    if (s.mode == "virtual")
+      line += Printf("  t=%.1f s (%.0fx)", s.simulated_s, static_cast<double>(s.speed_factor));
     if (!s.top_cob_ids.empty()) {
       line += "  top";
       for (std::size_t i = 0; i < s.top_cob_ids.size() && i < 4; ++i) {

@@ -31,6 +31,10 @@ Duration NodeGuarding::LifeTime() const {
   return std::chrono::milliseconds(guard_time_ms * factor);
 }
 
+void NodeGuarding::AddListenedIds(std::vector<std::uint32_t>& ids) const {
+  if (IsValidNodeId(node_id_)) ids.push_back(kErrorControlCobId + node_id_);
+}
+
 bool NodeGuarding::OnFrame(const CanFrame& frame) {
   if (!frame.remote() || frame.extended() || frame.error()) return false;
   if (!IsValidNodeId(node_id_) || frame.id != kErrorControlCobId + node_id_) return false;

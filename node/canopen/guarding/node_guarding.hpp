@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "bus/bus_port.hpp"
 #include "clock/scheduler.hpp"
@@ -43,6 +44,8 @@ class NodeGuarding {
   /// Handles a guard request (remote frame on 700h + own node-ID): returns true and replies.
   /// Not answered while the node is Initialising or has no valid node-ID. Does not allocate.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: the guarding RTR 700h + node-ID.
+  void AddListenedIds(std::vector<std::uint32_t>& ids) const;
 
   /// The node-ID whose COB-ID the guard requests use (initially 0: none answered).
   void SetNodeId(std::uint8_t node_id) { node_id_ = node_id; }

@@ -105,6 +105,11 @@ void HeartbeatConsumer::StopMonitoring(Entry& entry) {
   }
 }
 
+void HeartbeatConsumer::AddListenedIds(std::vector<std::uint32_t>& ids) const {
+  for (const auto& entry : entries_)
+    if (entry->state != State::kUnconfigured) ids.push_back(kErrorControlCobId + entry->node_id);
+}
+
 bool HeartbeatConsumer::OnFrame(const CanFrame& frame) {
   if (frame.extended() || frame.remote() || frame.error()) return false;
   if (frame.id <= kErrorControlCobId || frame.id > kErrorControlCobId + 127 || frame.dlc != 1) return false;

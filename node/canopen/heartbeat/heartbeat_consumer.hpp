@@ -62,6 +62,8 @@ class HeartbeatConsumer {
   /// CANopenNode's CO_HBconsumer). Always returns false: the frame is not consumed, so other
   /// services (e.g. an NMT master view) still see it. Does not allocate.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: the heartbeats of the nodes it monitors (1016h).
+  void AddListenedIds(std::vector<std::uint32_t>& ids) const;
 
   /// Restarts monitoring (reset communication): every configured entry goes back to waiting.
   void Reset();

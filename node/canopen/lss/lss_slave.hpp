@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "bus/bus_port.hpp"
 #include "clock/scheduler.hpp"
@@ -77,6 +78,8 @@ class LssSlave {
   /// may interpret it), false for all other frames. Frames with DLC ≠ 8 are consumed and ignored,
   /// like CANopenNode and c-open do; so is every request while a bit timing switch is running.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: the LSS master's 7E5h.
+  static void AddListenedIds(std::vector<std::uint32_t>& ids) { ids.push_back(kLssMasterToSlaveId); }
 
   /// The node-ID the stack now runs with (after reset communication); also becomes the pending ID.
   void SetActiveNodeId(std::uint8_t node_id);

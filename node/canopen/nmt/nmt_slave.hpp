@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "bus/bus_port.hpp"
 #include "bus/can_frame.hpp"
@@ -53,6 +54,8 @@ class NmtSlave {
   /// DLC 2), whoever it addresses, since no other service uses 000h; false for anything else
   /// (including 000h with DLC ≠ 2, which CiA 301 does not define and the slave ignores).
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to (an acceptance filter, broker README "Virtual time").
+  static void AddListenedIds(std::vector<std::uint32_t>& ids) { ids.push_back(0x000); }
 
   /// Executes an NMT command locally, as if received (LSS switch to waiting, self-start).
   /// Unknown command specifiers are ignored.

@@ -67,6 +67,15 @@ void PdoService::SetNmtState(NmtState state) {
     tpdo->SetOperational(operational);
 }
 
+void PdoService::AddListenedIds(std::vector<std::uint32_t>& ids) const {
+  for (const auto& rpdo : rpdos_)
+    if (rpdo->Listening() && !rpdo->config().comm().cob_id.extended)
+      ids.push_back(rpdo->config().comm().cob_id.can_id);
+  for (const auto& tpdo : tpdos_)
+    if (tpdo->Listening() && !tpdo->config().comm().cob_id.extended)
+      ids.push_back(tpdo->config().comm().cob_id.can_id);
+}
+
 bool PdoService::OnFrame(const CanFrame& frame) {
   if (!operational_ || frame.error()) return false;
   if (frame.remote()) {

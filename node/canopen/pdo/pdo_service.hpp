@@ -52,6 +52,8 @@ class PdoService {
   /// A data frame on an RPDO COB-ID, or a remote frame on a TPDO COB-ID. True if a PDO in use took
   /// it. Does not allocate.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: its active RPDOs, and its TPDOs (a remote request).
+  void AddListenedIds(std::vector<std::uint32_t>& ids) const;
 
   /// Wire to SyncService::OnSync: applies buffered synchronous RPDOs, then sends the synchronous
   /// TPDOs due and samples type 252 TPDOs. `counter` is 0 when the SYNC has no counter.

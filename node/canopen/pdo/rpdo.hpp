@@ -38,6 +38,9 @@ class Rpdo {
 
   std::size_t number() const { return number_; }
   PdoConfig& config() { return config_; }
+  const PdoConfig& config() const { return config_; }
+  /// Valid, usable and operational: frames of its COB-ID are taken (an acceptance filter asks).
+  bool Listening() const { return Active(); }
 
   /// After a write of either record: re-reads it. A new event timer value moves the running
   /// deadline to last reception + new value; any other change restarts reception.

@@ -37,6 +37,9 @@ class Tpdo {
 
   std::size_t number() const { return number_; }
   PdoConfig& config() { return config_; }
+  const PdoConfig& config() const { return config_; }
+  /// Valid, usable and operational: frames of its COB-ID are taken (an acceptance filter asks).
+  bool Listening() const { return Active(); }
 
   /// After a write of either record: re-reads it. A new event timer value re-arms the timer from
   /// now; any other change restarts the TPDO (timers, SYNC count, pending events).

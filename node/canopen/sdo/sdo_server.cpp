@@ -126,6 +126,11 @@ void SdoServer::SetEnabled(bool enabled) {
 
 // ---- receiving ---------------------------------------------------------------------------------
 
+void SdoServer::AddListenedIds(std::vector<std::uint32_t>& ids) const {
+  if ((request_cob_id_ & kCobIdInvalid) == 0 && (request_cob_id_ & kCobIdFrame) == 0)
+    ids.push_back(CanIdOf(request_cob_id_));
+}
+
 bool SdoServer::OnFrame(const CanFrame& frame) {
   if (!enabled_ || (request_cob_id_ & kCobIdInvalid) || (response_cob_id_ & kCobIdInvalid)) return false;
   if (frame.error() || frame.id != CanIdOf(request_cob_id_)) return false;

@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "bus/bus_port.hpp"
 #include "clock/scheduler.hpp"
@@ -83,6 +84,9 @@ class SdoServer {
   /// Handles one received frame. Returns true when the frame has this server's request COB-ID
   /// (and the server is enabled), whether or not it was a valid request.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: its request COB-ID (whatever the NMT state: a request
+  /// in stopped gets no answer, but it is heard).
+  void AddListenedIds(std::vector<std::uint32_t>& ids) const;
 
   bool Enabled() const { return enabled_; }
   /// True while a segmented or block transfer is in progress.

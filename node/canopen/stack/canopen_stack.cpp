@@ -1,5 +1,7 @@
 #include "node/canopen/stack/canopen_stack.hpp"
 
+#include <algorithm>
+
 namespace canfleet::canopen {
 
 namespace {
@@ -186,6 +188,23 @@ void CanopenStack::RefuseStorageWithoutStateDir() {
 void CanopenStack::ApplyNodeId(std::uint8_t node_id) {
   node_id_ = node_id;
   ResetCommunication();
+}
+
+std::vector<std::uint32_t> CanopenStack::ListenedIds() const {
+  // The same services, in the same order, as OnFrame routes to.
+  std::vector<std::uint32_t> ids;
+  LssSlave::AddListenedIds(ids);
+  if (Configured()) {
+    NmtSlave::AddListenedIds(ids);
+    guarding_.AddListenedIds(ids);
+    hb_consumer_.AddListenedIds(ids);
+    sdo_.AddListenedIds(ids);
+    sync_.AddListenedIds(ids);
+    pdo_.AddListenedIds(ids);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
 }
 
 void CanopenStack::OnFrame(const CanFrame& frame) {

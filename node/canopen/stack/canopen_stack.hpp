@@ -104,6 +104,11 @@ class CanopenStack final : private CommErrorSink {
   ParameterStore* store() { return store_.get(); }
   /// The last controller event (state, TEC, REC) reported by the bus port.
   const ControllerEvent& Controller() const { return controller_; }
+  /// The 11-bit identifiers the stack listens to now, sorted: a frame with another 11-bit
+  /// identifier would change nothing (an acceptance filter; orchestrator/broker/README.md "Virtual
+  /// time"). Extended frames are not covered: they always reach the stack. Follows the NMT state,
+  /// the LSS configuration and the communication objects as they are now.
+  std::vector<std::uint32_t> ListenedIds() const;
 
   /// Local NMT transition (device logic, tests). Same effect as the NMT command.
   void SetState(NmtState state) { nmt_.SetState(state); }

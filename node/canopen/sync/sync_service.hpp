@@ -52,6 +52,11 @@ class SyncService {
   /// Handles a SYNC frame: true if the frame has the SYNC COB-ID (format included) and the NMT
   /// state lets the service act on it, even if it was rejected for its length. Does not allocate.
   bool OnFrame(const CanFrame& frame);
+  /// The 11-bit identifiers it listens to: the SYNC COB-ID (1005h), also as producer (another
+  /// producer on the bus is an error it must see).
+  void AddListenedIds(std::vector<std::uint32_t>& ids) const {
+    if (!cob_.extended) ids.push_back(cob_.can_id);
+  }
 
   /// Adds a listener called at every SYNC, received or produced, with the counter (0 when
   /// 1019h = 0). Listeners run in the order they were added.

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "node/canopen/stack/standard_objects.hpp"
@@ -389,6 +390,38 @@ TEST_F(BitRateObjectTest, AdoptedBitTimingIsTheObjectsValue) {
   EXPECT_EQ(od.GetUnsigned(0x5B50, 0), 2u);
   EXPECT_EQ(stack.lss().ActiveBitTimingIndex(), 2u);
   EXPECT_EQ(stack.lss().PendingBitTimingIndex(), 2u);
+}
+
+}  // namespace
+}  // namespace canfleet::canopen
+
+namespace canfleet::canopen {
+namespace {
+
+bool Has(const std::vector<std::uint32_t>& ids, std::uint32_t id) {
+  return std::find(ids.begin(), ids.end(), id) != ids.end();
+}
+
+// The acceptance filter a node reports in virtual time (orchestrator/broker/README.md "Virtual
+// time"): the identifiers its services take (CiA 301 §7.3.2.2: NMT 000h, SDO 600h + ID, node
+// guarding 700h + ID; CiA 305: LSS 7E5h), following its configuration: a heartbeat consumer
+// configured by SDO (1016h) adds the producer's 700h + ID.
+TEST_F(StackTest, ListensToTheIdentifiersOfItsServicesAndFollowsItsConfiguration) {
+  stack->Start();
+  std::vector<std::uint32_t> ids = stack->ListenedIds();
+  EXPECT_TRUE(std::is_sorted(ids.begin(), ids.end()));
+  for (std::uint32_t id : {0x000u, 0x605u, 0x705u, 0x7E5u})
+    EXPECT_TRUE(Has(ids, id)) << std::hex << id;
+  EXPECT_FALSE(Has(ids, 0x703));
+  EXPECT_FALSE(Has(ids, 0x185)) << "a TPDO of another node is nothing to this one";
+  master.Send("605#2316100164000300");  // 1016h.1 = node 3, 100 ms
+  EXPECT_TRUE(Has(stack->ListenedIds(), 0x703));
+}
+
+// CiA 305: a node without a node-ID runs LSS only, so it listens to LSS only.
+TEST_F(UnconfiguredStackTest, AnUnconfiguredNodeListensToLssOnly) {
+  stack->Start();
+  EXPECT_EQ(stack->ListenedIds(), (std::vector<std::uint32_t>{0x7E5}));
 }
 
 }  // namespace

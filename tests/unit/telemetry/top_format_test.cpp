@@ -306,3 +306,26 @@ TEST(TopText, SortKeysCycleAndParse) {
 
 }  // namespace
 }  // namespace canfleet::tools
+
+namespace canfleet::tools {
+namespace {
+
+// Virtual time (orchestrator/broker/README.md "Virtual time"): a bus line shows the simulated time
+// and the factor achieved, so a person watching knows what the clocks mean.
+TEST(TopFormatVirtualTime, ABusInVirtualTimeShowsSimulatedTimeAndTheFactor) {
+  FleetView view{kNow - 200s};
+  telemetry::BusStatsSample stats;
+  stats.bus = "can0";
+  stats.bitrate = 250'000;
+  stats.mode = "virtual";
+  stats.simulated_s = 3600.04;
+  stats.speed_factor = 70.4F;
+  view.Apply(stats, At(kNow - 1s), nullptr);
+  RenderSettings settings{.color = false, .now = kNow};
+  const std::string frame = RenderFrame(view, settings);
+  EXPECT_NE(frame.find("virtual"), std::string::npos) << frame;
+  EXPECT_NE(frame.find("t=3600.0 s (70x)"), std::string::npos) << frame;
+}
+
+}  // namespace
+}  // namespace canfleet::tools

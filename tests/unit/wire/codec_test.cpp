@@ -64,6 +64,8 @@ Bytes MixedStream() {
   w.AddTimeGrant(7000, 7024);
   w.AddTimeReached(7024, 500'000'000);
   w.AddTimeReached(7024, std::nullopt);
+  w.AddAcceptance(std::vector<std::uint32_t>{0x000, 0x605, 0x7E5});
+  w.AddAcceptance(std::nullopt);
   w.AddError("bye");
   return ToBytes(w.Bytes());
 }
@@ -85,6 +87,8 @@ const std::vector<std::string> kMixedExpected = {
     "TimeGrant 7000..7024",
     "TimeReached 7024 next 500000000",
     "TimeReached 7024 idle",
+    "Acceptance 3 ids",
+    "Acceptance all",
     "Error bye",
 };
 

@@ -67,6 +67,11 @@ inline std::string Describe(const Message& m) {
       out += " " + std::to_string(m.envelope.time_grant().now_ns()) + ".." +
              std::to_string(m.envelope.time_grant().until_ns());
       break;
+    case MessageType::kAcceptance:
+      out += m.envelope.acceptance().all()
+                 ? " all"
+                 : " " + std::to_string(m.envelope.acceptance().ids_size()) + " ids";
+      break;
     case MessageType::kTimeReached:
       out += " " + std::to_string(m.envelope.time_reached().time_ns()) +
              (m.envelope.time_reached().has_deadline()
