@@ -81,7 +81,7 @@ struct NodeTelemetry::Impl {
   bool has_io() const { return !options.inputs.empty() || !options.outputs.empty(); }
 
   const NodeTelemetryOptions options;
-  TimePoint started{};  ///< the loop's time when the publisher was made (uptime)
+  TimePoint started{};  ///< the uptime clock's time when the publisher was made
 
   // DDS entities; the participant deletes the topics.
   Topic<canfleet_telemetry_NodeStatus> status_topic;
@@ -157,7 +157,9 @@ struct NodeTelemetry::Impl {
     status.rpdo_count = s.rpdo_count;
     status.tpdo_count = s.tpdo_count;
     status.uptime_ms = static_cast<std::uint64_t>(
-        std::chrono::duration_cast<std::chrono::milliseconds>(now - started).count());
+        std::chrono::duration_cast<std::chrono::milliseconds>(
+            (options.uptime_clock != nullptr ? options.uptime_clock->Now() : now) - started)
+            .count());
     status.last_emcy.valid = last_emcy.has_value();
     if (last_emcy) {
       status.last_emcy.code = last_emcy->code;
@@ -196,7 +198,7 @@ void NodeTelemetry::Init(const Participant& participant, NodeTelemetryOptions op
   }
   if (options.period <= std::chrono::milliseconds::zero()) throw std::invalid_argument("period must be > 0");
   impl_ = std::make_unique<Impl>(participant, std::move(options));
-  impl_->started = Now();
+  impl_->started = impl_->options.uptime_clock != nullptr ? impl_->options.uptime_clock->Now() : Now();
   Start();
 }
 

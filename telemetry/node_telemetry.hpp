@@ -64,6 +64,10 @@ struct NodeTelemetryOptions {
   std::vector<IoChannel> outputs{};
   /// EMCYs waiting for the publisher thread; beyond this they are counted as dropped.
   std::size_t emcy_queue = 64;
+  /// The node's own clock for the uptime (its Now() must be safe to read from the publisher's
+  /// thread, as AsioScheduler's and GrantedScheduler's are): in virtual time the uptime is then
+  /// simulated time. nullptr: the publisher loop's clock.
+  const Scheduler* uptime_clock = nullptr;
 };
 
 /// Counters for tests and benchmarks.

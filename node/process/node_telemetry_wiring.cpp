@@ -75,6 +75,7 @@ struct NodeTelemetryWiring::Impl {
   TelemetrySettings settings;
   telemetry::Participant participant;  // declared first: outlives the publishers
   devices::DeviceNode* node = nullptr;
+  const Scheduler* scheduler = nullptr;  ///< the node's: the uptime follows its time (virtual too)
   std::vector<Port> ports;
   std::vector<telemetry::IoChannel> input_channels;
   std::vector<telemetry::IoChannel> output_channels;
@@ -91,7 +92,8 @@ struct NodeTelemetryWiring::Impl {
             .period = settings.period,
             .min_interval = std::chrono::milliseconds(20),
             .inputs = input_channels,
-            .outputs = output_channels};
+            .outputs = output_channels,
+            .uptime_clock = scheduler};
   }
 
   void CollectIo() {
@@ -217,6 +219,7 @@ void NodeTelemetryWiring::Attach(devices::DeviceNode& node, Scheduler& scheduler
     }
   }
   m.node = &node;
+  m.scheduler = &scheduler;
   m.CollectIo();
   for (std::size_t p = 0; p < buses.size(); ++p) {
     Impl::Port port;
