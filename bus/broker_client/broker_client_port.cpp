@@ -442,7 +442,8 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
     const bool other_rate = options_.bitrate != 0 && options_.bitrate != session_.bitrate;
     const std::string detail =
         endpoint_.ToString() + " bus " + options_.bus + " (" + std::to_string(session_.bitrate) + " bit/s, " +
-        (session_.paced ? "paced" : "unpaced") + "), port " + std::to_string(session_.port_id) +
+        (session_.paced ? "paced" : "unpaced") + (session_.virtual_time ? ", virtual time" : "") +
+        "), port " + std::to_string(session_.port_id) +
         (other_rate ? ", controller at " + std::to_string(options_.bitrate) + " bit/s" : std::string());
     spdlog::info("connected to broker at {}", detail);
     const std::uint64_t gen = generation_;

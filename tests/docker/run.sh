@@ -375,6 +375,7 @@ for s in socks: s.bind(("127.0.0.1", 0))
 print(*[s.getsockname()[1] for s in socks])')
   cat >"$vt_dir/vt.textproto" <<TOPOLOGY
 name: "docker-virtual-time"
+orchestrator { state_root: "/tmp/docker-virtual-time" }
 time { mode: VIRTUAL speed: 20 }
 bus { name: "can0" bitrate: 250000 }
 node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0" external: true
