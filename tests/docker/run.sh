@@ -368,6 +368,7 @@ virtual_time_in_containers() {
   local t control broker
   t=$(date +%s)
   vt_dir=$(mktemp -d /tmp/canfleet-docker-vt-XXXXXX)
+  chmod 0755 "$vt_dir" # the image's user reads the topology from it (mktemp makes it 0700)
   read -r control broker < <(python3 -c '
 import socket
 socks = [socket.socket() for _ in range(2)]
