@@ -19,6 +19,20 @@ host::HostTime FleetTime(const topology::Topology& spec, const TimeOverride& ove
   return time;
 }
 
+void UseHostTime(FleetOptions& options, const transport::TimeConductor* conductor) {
+  options.conductor = conductor;
+  if (conductor != nullptr)
+    options.node_arguments.insert(options.node_arguments.end(), {"--time", "virtual"});
+}
+
+control::ControlHandler& ControlHandlerFor(control::ControlHandler& fleet,
+                                           transport::TimeConductor* conductor,
+                                           std::unique_ptr<BoundaryControlHandler>& holder) {
+  if (conductor == nullptr) return fleet;
+  holder = std::make_unique<BoundaryControlHandler>(fleet, *conductor);
+  return *holder;
+}
+
 void BoundaryControlHandler::Handle(const control::Request& request,
                                     std::shared_ptr<control::Responder> responder) {
   conductor_.AtBoundary([this, request, responder = std::move(responder)]() mutable {

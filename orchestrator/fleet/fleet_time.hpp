@@ -10,6 +10,7 @@
 #include <string>
 
 #include "orchestrator/control/control_handler.hpp"
+#include "orchestrator/fleet/fleet.hpp"
 #include "orchestrator/host/broker_host.hpp"
 #include "orchestrator/topology/canfleet_topology.pb.h"
 #include "orchestrator/transport/time_conductor.hpp"
@@ -39,5 +40,15 @@ class BoundaryControlHandler final : public control::ControlHandler {
   control::ControlHandler& inner_;
   transport::TimeConductor& conductor_;
 };
+
+/// In virtual time (a conductor): the fleet's nodes run on the broker's clock (--time virtual) and
+/// its status shows simulated time. Nothing in real time (nullptr).
+void UseHostTime(FleetOptions& options, const transport::TimeConductor* conductor);
+
+/// What the control server serves: the fleet itself, or in virtual time the fleet between rounds
+/// (a BoundaryControlHandler made in `holder`, which must outlive the server).
+control::ControlHandler& ControlHandlerFor(control::ControlHandler& fleet,
+                                           transport::TimeConductor* conductor,
+                                           std::unique_ptr<BoundaryControlHandler>& holder);
 
 }  // namespace canfleet::fleet

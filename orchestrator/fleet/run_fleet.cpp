@@ -117,17 +117,11 @@ int RunFleet(const UpOptions& options) {
     fleet_options.wall_origin = host.wall_origin();
     fleet_options.repeat_scenario = true;
     fleet_options.seed = spec.time().seed();
-    fleet_options.conductor = host.conductor();
-    if (host.conductor())
-      fleet_options.node_arguments.insert(fleet_options.node_arguments.end(), {"--time", "virtual"});
+    UseHostTime(fleet_options, host.conductor());
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
-    control::ControlHandler* handler = fleet.get();
-    if (host.conductor()) {
-      boundary = std::make_unique<BoundaryControlHandler>(*fleet, *host.conductor());
-      handler = boundary.get();
-    }
-    control_server = std::make_unique<control::ControlServer>(io, *handler);
+    control_server =
+        std::make_unique<control::ControlServer>(io, ControlHandlerFor(*fleet, host.conductor(), boundary));
     const auto bound = control_server->Listen(spec.orchestrator().control());
     control_endpoint = "tcp://" + wire::TcpEndpointText(bound);
   } catch (const std::exception& e) {

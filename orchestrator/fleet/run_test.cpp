@@ -135,16 +135,10 @@ class FileRun {
       if (!options_.telemetry) fleet_options.node_arguments.push_back("--no-telemetry");
       fleet_options.wall_origin = host.wall_origin();
       fleet_options.seed = options_.seed ? *options_.seed : spec.time().seed();
-      fleet_options.conductor = host.conductor();
-      if (host.conductor())
-        fleet_options.node_arguments.insert(fleet_options.node_arguments.end(), {"--time", "virtual"});
+      UseHostTime(fleet_options, host.conductor());
       fleet = std::make_unique<Fleet>(io, scheduler, host.broker(), host.server(), std::move(fleet_options));
-      control::ControlHandler* handler = fleet.get();
-      if (host.conductor()) {
-        boundary = std::make_unique<BoundaryControlHandler>(*fleet, *host.conductor());
-        handler = boundary.get();
-      }
-      control_server = std::make_unique<control::ControlServer>(io, *handler);
+      control_server =
+          std::make_unique<control::ControlServer>(io, ControlHandlerFor(*fleet, host.conductor(), boundary));
       if (!options_.capture.empty()) {
         fs::create_directories(options_.capture);
         for (const auto& bus : spec.bus()) {
