@@ -8,47 +8,10 @@
 
 namespace canfleet::devices::test {
 
-std::string LeHex(std::uint64_t value, int size) {
-  std::string out;
-  char buf[4];
-  for (int i = 0; i < size; ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", static_cast<unsigned>((value >> (8 * i)) & 0xFF));
-    out += buf;
-  }
-  return out;
-}
-
 std::string Cob(std::uint32_t cob_id) {
   char buf[8];
   std::snprintf(buf, sizeof buf, "%03X#", static_cast<unsigned>(cob_id));
   return buf;
-}
-
-namespace {
-
-std::string Multiplexer(std::uint16_t index, std::uint8_t sub) {
-  return LeHex(index, 2) + LeHex(sub, 1);
-}
-
-}  // namespace
-
-std::string SdoWrite(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint64_t value,
-                     int size) {
-  static const char* kCommand[] = {"", "2F", "2B", "27", "23"};
-  return Cob(0x600u + node) + kCommand[size] + Multiplexer(index, sub) + LeHex(value, size) +
-         std::string(static_cast<std::size_t>(2 * (4 - size)), '0');
-}
-
-std::string SdoWritten(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
-  return Cob(0x580u + node) + "60" + Multiplexer(index, sub) + "00000000";
-}
-
-std::string SdoAborted(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t code) {
-  return Cob(0x580u + node) + "80" + Multiplexer(index, sub) + LeHex(code, 4);
-}
-
-std::string SdoRead(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
-  return Cob(0x600u + node) + "40" + Multiplexer(index, sub) + "00000000";
 }
 
 std::string Emcy(std::uint8_t node, std::uint16_t code, std::uint8_t reg, std::uint8_t channel,

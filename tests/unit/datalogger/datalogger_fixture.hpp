@@ -20,20 +20,30 @@
 #include "node/devices/datalogger_tc_analog/datalogger.hpp"
 #include "node/devices/device_node.hpp"
 #include "tests/support/bus_probe.hpp"
+#include "tests/support/sdo_script.hpp"
 
 namespace canfleet::devices::test {
 
 using namespace std::chrono_literals;
 
-/// Little-endian hex of the low `size` bytes of `value` ("E803" for 1000, 2 bytes).
-std::string LeHex(std::uint64_t value, int size);
+using canfleet::test::LeHex;
 /// "<cob>#..." with the COB-ID in three hex digits.
 std::string Cob(std::uint32_t cob_id);
-/// SDO expedited download request to `node`.
-std::string SdoWrite(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint64_t value, int size);
-std::string SdoWritten(std::uint8_t node, std::uint16_t index, std::uint8_t sub);
-std::string SdoAborted(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t code);
-std::string SdoRead(std::uint8_t node, std::uint16_t index, std::uint8_t sub);
+/// The master's SDO frame scripts of every product fixture (tests/support/sdo_script.hpp), under
+/// the names the data logger's tests use.
+inline std::string SdoWrite(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint64_t value,
+                            int size) {
+  return canfleet::test::SdoDownload(node, index, sub, value, size);
+}
+inline std::string SdoWritten(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
+  return canfleet::test::SdoDownloaded(node, index, sub);
+}
+inline std::string SdoAborted(std::uint8_t node, std::uint16_t index, std::uint8_t sub, std::uint32_t code) {
+  return canfleet::test::SdoAbortFrom(node, index, sub, code);
+}
+inline std::string SdoRead(std::uint8_t node, std::uint16_t index, std::uint8_t sub) {
+  return canfleet::test::SdoUpload(node, index, sub);
+}
 /// The family's EMCY: code, 1001h, channel, description (family_error_policy.hpp).
 std::string Emcy(std::uint8_t node, std::uint16_t code, std::uint8_t reg, std::uint8_t channel,
                  std::uint8_t description);
