@@ -17,8 +17,13 @@ the window (deviation from 500 ms: min/p50/p99/max) and the EMCY 8130h frames (h
 of the whole run: false faults, since nothing is injected. It is a benchmark, not a test: it prints
 figures.
 
-  bench/idle/idle_bench.py --bin build/ [--nodes 10] [--window 30] [--settle 5] [--operational]
-                           [--no-telemetry] [--monitor] [--device quad-controller] [--eds BASE.eds]
+A bus has at most 127 node-IDs: --buses K spreads the nodes over K buses of the one broker
+(can0, can1, ...; node-IDs 1.. on each, each consuming its neighbour's heartbeat on its own bus),
+so 500 nodes run as --nodes 500 --buses 4.
+
+  bench/idle/idle_bench.py --bin build/ [--nodes 10] [--buses 1] [--window 30] [--settle 5]
+                           [--operational] [--no-telemetry] [--monitor] [--device quad-controller]
+                           [--eds BASE.eds]
 """
 
 import argparse
@@ -106,9 +111,11 @@ def rss_kib(pid):
 
 
 class Monitor:
-    """Reads canfleet-bus-client --monitor: "rx BUS_TIME_NS ID#DATA" lines."""
+    """Reads canfleet-bus-client --monitor: "rx BUS_TIME_NS ID#DATA" lines. Nodes are keyed
+    (bus, node-ID)."""
 
-    def __init__(self, cmd):
+    def __init__(self, cmd, bus):
+        self.bus = bus
         self.proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, text=True, bufsize=1)
         self.lock = threading.Lock()
@@ -130,7 +137,7 @@ class Monitor:
             can_id, t = int(ident, 16), int(parts[1])
             with self.lock:
                 if 0x701 <= can_id <= 0x77F and len(data) == 2:
-                    node = can_id - 0x700
+                    node = (self.bus, can_id - 0x700)
                     self.first_seen.setdefault(node, time.monotonic())
                     if data != "00":  # 00 is the boot-up
                         self.heartbeats.setdefault(node, []).append(t)
@@ -160,6 +167,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", required=True, help="build folder with canfleet-node and canfleet-broker")
     ap.add_argument("--nodes", type=int, default=10)
+    ap.add_argument("--buses", type=int, default=1, help="spread the nodes over this many buses")
     ap.add_argument("--window", type=float, default=30.0, help="measurement window, seconds")
     ap.add_argument("--settle", type=float, default=5.0, help="seconds between start and measurement")
     ap.add_argument("--bitrate", default="250k")
@@ -170,8 +178,13 @@ def main():
     ap.add_argument("--monitor", action="store_true",
                     help="listen on the bus: start time, heartbeat periods, EMCY 8130h")
     args = ap.parse_args()
-    if not 1 <= args.nodes <= 127:
-        sys.exit("--nodes: 1..127")
+    if args.buses < 1 or not 1 <= args.nodes <= 127 * args.buses:
+        sys.exit("--nodes: 1..127 per bus (--buses)")
+    per_bus = -(-args.nodes // args.buses)  # ceiling
+    bus_names = [f"can{b}" for b in range(args.buses)]
+    # Node k (0-based) is on bus k // per_bus with node-ID k % per_bus + 1.
+    placement = [(k // per_bus, k % per_bus + 1) for k in range(args.nodes)]
+    on_bus = [sum(1 for b, _ in placement if b == bus) for bus in range(args.buses)]
 
     node_bin = find_binary(args.bin, "canfleet-node")
     broker_bin = find_binary(args.bin, "canfleet-broker")
@@ -181,11 +194,12 @@ def main():
 
     work = tempfile.mkdtemp(prefix="canfleet-idle-")
     procs = []
-    monitor = None
+    monitors = []
     try:
         sock = os.path.join(work, "broker.sock")
         ready = os.path.join(work, "ready")
-        broker = subprocess.Popen([broker_bin, "--bus", f"can0:{args.bitrate}", "--listen", f"unix://{sock}",
+        bus_args = [a for name in bus_names for a in ("--bus", f"{name}:{args.bitrate}")]
+        broker = subprocess.Popen([broker_bin, *bus_args, "--listen", f"unix://{sock}",
                                    "--ready-file", ready, "--no-telemetry", "--log-level", "warn"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         procs.append(broker)
@@ -195,22 +209,25 @@ def main():
                 sys.exit("the broker did not start")
             time.sleep(0.05)
         if args.monitor:
-            monitor = Monitor([find_binary(args.bin, "canfleet-bus-client"), "--connect", f"unix://{sock}",
-                               "--bus", "can0", "--monitor", "--name", "idle-bench-monitor", "--log-level", "warn"])
-            if not monitor.connected.wait(10):
-                sys.exit("the bus monitor did not connect")
+            for b, name in enumerate(bus_names):
+                monitors.append(Monitor([find_binary(args.bin, "canfleet-bus-client"), "--connect", f"unix://{sock}",
+                                         "--bus", name, "--monitor", "--name", f"idle-bench-monitor-{name}",
+                                         "--log-level", "warn"], b))
+            for m in monitors:
+                if not m.connected.wait(10):
+                    sys.exit(f"the monitor of {bus_names[m.bus]} did not connect")
         nodes = []
         launched = time.monotonic()
-        for i in range(1, args.nodes + 1):
-            neighbour = i % args.nodes + 1
+        for k, (b, i) in enumerate(placement):
+            neighbour = i % on_bus[b] + 1
             node_eds = eds
-            if args.nodes > 1:
+            if on_bus[b] > 1:
                 node_eds = set_default(node_eds, "1016sub1", f"0x{(neighbour << 16) | 1500:08X}")
-            path = os.path.join(work, f"node{i}.eds")
+            path = os.path.join(work, f"node{k + 1}.eds")
             with open(path, "w", encoding="utf-8") as f:
                 f.write(node_eds)
             cmd = [node_bin, "--device", args.device, "--eds", path, "--node-id", str(i),
-                   "--bus", f"can0@unix://{sock}", "--log-level", "warn"]
+                   "--bus", f"{bus_names[b]}@unix://{sock}", "--log-level", "warn"]
             if args.no_telemetry:
                 cmd.append("--no-telemetry")
             p = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -224,10 +241,12 @@ def main():
         load_start = os.getloadavg()[0]
         before = {p.pid: sample(p.pid) for p in nodes + [broker]}
         t0 = time.monotonic()
-        if monitor:
-            with monitor.lock:
-                hb_mark = {n: len(v) for n, v in monitor.heartbeats.items()}
-                losses_before_window = monitor.heartbeat_losses
+        hb_mark = {}
+        losses_before_window = 0
+        for m in monitors:
+            with m.lock:
+                hb_mark.update({n: len(v) for n, v in m.heartbeats.items()})
+                losses_before_window += m.heartbeat_losses
         time.sleep(args.window)
         after = {p.pid: sample(p.pid) for p in nodes + [broker]}
         elapsed = time.monotonic() - t0
@@ -239,7 +258,9 @@ def main():
                     (sw_b - sw_a) / elapsed)
 
         per_node = [rates(p.pid) for p in nodes]
-        print(f"{args.nodes} x {args.device} on can0:{args.bitrate}, "
+        where = f"{args.buses} buses at {args.bitrate} ({per_bus} nodes each at most)" if args.buses > 1 \
+            else f"can0:{args.bitrate}"
+        print(f"{args.nodes} x {args.device} on {where}, "
               f"{'operational (TPDOs every 100 ms)' if args.operational else 'pre-operational'}, "
               f"heartbeat 500 ms + consumer 1500 ms, telemetry {'off' if args.no_telemetry else 'on'}, "
               f"window {elapsed:.1f} s, load average {load_start:.2f} at its start, {os.getloadavg()[0]:.2f} at its end")
@@ -250,15 +271,18 @@ def main():
         b = rates(broker.pid)
         total = sum(r[1] for r in per_node) + b[1]
         print(f"  broker CPU % (schedstat) {b[1]:.3f}, wake-ups/s {b[2]:.1f}; nodes + broker {total:.2f} % of a core")
-        if monitor:
-            time.sleep(0.5)  # the last frames of the window reach the monitor
-            with monitor.lock:
-                seen = dict(monitor.first_seen)
-                deviations = []
-                for n, times in monitor.heartbeats.items():
-                    window = times[max(hb_mark.get(n, 0) - 1, 0):]
-                    deviations += [(b2 - a2) / 1e6 - 500.0 for a2, b2 in zip(window, window[1:])]
-                losses = monitor.heartbeat_losses
+        if monitors:
+            time.sleep(0.5)  # the last frames of the window reach the monitors
+            seen = {}
+            deviations = []
+            losses = 0
+            for m in monitors:
+                with m.lock:
+                    seen.update(m.first_seen)
+                    for n, times in m.heartbeats.items():
+                        window = times[max(hb_mark.get(n, 0) - 1, 0):]
+                        deviations += [(b2 - a2) / 1e6 - 500.0 for a2, b2 in zip(window, window[1:])]
+                    losses += m.heartbeat_losses
             ready = (f"{max(seen.values()) - launched:.1f} s" if len(seen) == args.nodes
                      else f"not all seen ({len(seen)} of {args.nodes})")
             print(f"  fleet start (launch -> every node seen on the bus): {ready}")
@@ -268,8 +292,8 @@ def main():
             print(f"  EMCY 8130h (heartbeat lost): {losses - losses_before_window} in the window, "
                   f"{losses} in the whole run")
     finally:
-        if monitor:
-            monitor.stop()
+        for m in monitors:
+            m.stop()
         for p in reversed(procs):
             if p.poll() is None:
                 p.send_signal(signal.SIGTERM)

@@ -369,6 +369,30 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
     ScheduleFlush();
   }
 
+  /// Real time: before each write, the filter as the node's configuration now makes it; a change
+  /// goes first in the write, ahead of the frames that answer what changed it (an SDO download's
+  /// response, a boot-up after a reset), so the broker applies it before anyone hears the answer.
+  /// A configuration changes only with a command the node answers (CanopenStack::ListenedIds), so
+  /// only frames already in flight when the command came can miss a new filter, as on a real
+  /// controller whose filter is being rewritten.
+  void RefreshAcceptance() {
+    if (!acceptance) return;
+    auto ids = acceptance();
+    if (acceptance_sent_ && ids == last_acceptance_) return;
+    if (filling_.empty()) {
+      filling_.AddAcceptance(ids);
+    } else {
+      acceptance_first_.Clear();
+      acceptance_first_.AddAcceptance(ids);
+      const std::span<const std::uint8_t> rest = filling_.Bytes();
+      acceptance_first_.AddEncoded(rest.data(), rest.size());
+      filling_.Swap(acceptance_first_);
+      acceptance_first_.Clear();
+    }
+    last_acceptance_ = std::move(ids);
+    acceptance_sent_ = true;
+  }
+
   /// Counts error frames; the first one after a connection or a rate change is logged, with the
   /// rates when they differ (the usual cause: the controller is at another rate than the bus).
   void OnErrorFrame(const CanFrame& frame) {
@@ -527,7 +551,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   /// Writes everything appended so far in one write, straight away; what the socket does not take
   /// is written asynchronously, and what is appended meanwhile waits for it.
   void Flush() {
-    if (write_in_flight_ || filling_.empty() || !socket_.is_open()) return;
+    if (write_in_flight_ || !socket_.is_open()) return;
+    if (!options_.virtual_time && phase_ == Phase::kConnected) RefreshAcceptance();
+    if (filling_.empty()) return;
     const std::span<const std::uint8_t> bytes = filling_.Bytes();
     const iovec buffer{const_cast<std::uint8_t*>(bytes.data()), bytes.size()};
     std::error_code ec;
@@ -573,8 +599,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
 
   wire::StreamDecoder decoder_;
   wire::Message message_;
-  wire::MessageWriter filling_;  ///< appended to by Send and replies
-  wire::MessageWriter writing_;  ///< the unwritten rest of a write the socket took only in part
+  wire::MessageWriter filling_;           ///< appended to by Send and replies
+  wire::MessageWriter writing_;           ///< the unwritten rest of a write the socket took only in part
+  wire::MessageWriter acceptance_first_;  ///< real time: a new filter ahead of filling_'s messages
   bool write_in_flight_ = false;
   bool flush_posted_ = false;
   bool reading_ = false;  ///< delivering the messages of one read; it flushes when done

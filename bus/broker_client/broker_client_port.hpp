@@ -97,8 +97,10 @@ class BrokerClientPort final : public BusPort {
   /// Called on the io thread; the reply's request_id is filled in by the port. It may destroy the
   /// port (then nothing is sent).
   using NodeRequestHandler = std::function<wire::NodeReply(const wire::NodeRequest&)>;
-  /// Virtual time: the 11-bit identifiers the node listens to now (nullopt: every frame), asked at
-  /// the end of each grant; a change is sent to the broker (Acceptance) before TimeReached.
+  /// The 11-bit identifiers the node listens to (nullopt: every frame): its acceptance filter,
+  /// which the broker applies to what it delivers. Virtual time: asked at the end of each grant, a
+  /// change sent before TimeReached. Real time: asked before each write, a change sent first in
+  /// that write. Until the first Acceptance of a connection the broker delivers every frame.
   using AcceptanceProvider = std::function<std::optional<std::vector<std::uint32_t>>()>;
 
   /// Throws std::invalid_argument on a malformed endpoint.

@@ -180,8 +180,8 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     if (client == nullptr) continue;
     client->OnNodeRequest(
         [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
-    // Virtual time: the broker wakes the node only for frames its stack listens to.
-    if (options.virtual_time) client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
+    // The broker wakes the node only for frames its stack listens to (an acceptance filter).
+    client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
   }
   for (const auto& assignment : options.io) {
     auto eq = assignment.find('=');

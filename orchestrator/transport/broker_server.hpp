@@ -49,6 +49,7 @@ struct BrokerServerStats {
   std::uint64_t refused = 0;          ///< Hellos refused (version, unknown bus, bad names)
   std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or out-of-order data
   std::uint64_t backlog_drops = 0;    ///< frames not sent to slow readers
+  std::uint64_t filtered_frames = 0;  ///< frames not sent to a node whose acceptance filter rejects them
   std::uint64_t node_requests = 0;    ///< RequestNode calls
   std::uint64_t node_replies = 0;     ///< of those, answered by the node (error or not)
   std::uint64_t reads = 0;            ///< recv calls on sessions

@@ -427,14 +427,15 @@ void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
     stats_->backlog_drops += frames.size();
     return;
   }
-  if (granted_ && !accept_all_) {
-    // Virtual time: what the node does not listen to does not wake it.
+  if (!accept_all_) {
+    // What the node does not listen to does not wake it (its acceptance filter).
     std::size_t accepted = 0;
     for (const broker::TimedFrame& f : frames) {
       if (!Accepts(f.frame)) continue;
       filling_.AddFrame(f.frame, f.time);
       ++accepted;
     }
+    stats_->filtered_frames += frames.size() - accepted;
     if (accepted > 0) Queued();
     return;
   }
@@ -453,19 +454,25 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
-  if (granted_ && !accept_all_) {
-    // Virtual time: what the node does not listen to does not wake it.
+  if (!accept_all_) {
+    // What the node does not listen to does not wake it (its acceptance filter). When it takes
+    // every frame of the round, they go out as without a filter (gathered, below).
     const std::span<const broker::TimedFrame> all = round.Frames();
     std::size_t accepted = 0;
-    for (const broker::FrameRun& run : runs) {
-      for (std::uint32_t i = run.begin; i < run.end; ++i) {
-        if (!Accepts(all[i].frame)) continue;
-        filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{i} * wire::kFrameRecordSize, 1);
-        ++accepted;
-      }
+    for (const broker::FrameRun& run : runs)
+      for (std::uint32_t i = run.begin; i < run.end; ++i)
+        accepted += Accepts(all[i].frame) ? 1 : 0;
+    stats_->filtered_frames += frames - accepted;
+    if (accepted == 0) return;
+    if (accepted < frames) {
+      for (const broker::FrameRun& run : runs)
+        for (std::uint32_t i = run.begin; i < run.end; ++i)
+          if (Accepts(all[i].frame))
+            filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{i} * wire::kFrameRecordSize,
+                                1);
+      Queued();
+      return;
     }
-    if (accepted > 0) Queued();
-    return;
   }
   // In virtual time the grant that follows sends the frames: frames and grant in one write.
   if (!granted_ && !write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&

@@ -138,7 +138,8 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   bool closed_ = false;
   bool hello_seen_ = false;  ///< a Hello arrived (in virtual time it is accepted between rounds)
   bool granted_ = false;     ///< a node in virtual time: the conductor grants its time
-  /// Virtual time: the node's acceptance filter (Acceptance); until it sends one, every frame.
+  /// The node's acceptance filter (Acceptance), in real and virtual time; until it sends one,
+  /// every frame.
   bool accept_all_ = true;
   std::bitset<2048> accepted_;
   /// Whether `frame` passes the filter (extended and error frames always do).

@@ -293,6 +293,46 @@ TEST_F(Transport, MonitorSeesFramesAndErrorFramesButCannotSend) {
   ASSERT_TRUE(RunUntil([&] { return std::find(seen.begin(), seen.end(), "181#AA") != seen.end(); }));
 }
 
+// Acceptance filters in real time (orchestrator/broker/README.md "Acceptance filters"): a node
+// is sent only the identifiers it listens to, and a filter changed by a command the node answers
+// reaches the broker ahead of the answer, so a peer reacting to the answer is heard.
+TEST_F(Transport, ARealTimeNodeGetsOnlyWhatItsFilterTakesAndANewFilterTravelsAheadOfTheAnswer) {
+  transport::BrokerServer server(io_, broker_);
+  auto [master, node] = ConnectedPair(server);
+  ASSERT_TRUE(master->Connected() && node->Connected());
+  std::vector<std::uint32_t> listened{0x000, 0x605};
+  node->OnAcceptance([&] { return std::optional(listened); });
+  std::vector<std::string> node_got;
+  std::vector<std::string> master_got;
+  node->OnReceive([&](const CanFrame& f, BusTime) {
+    node_got.push_back(ToCandump(f));
+    if (f.id == 0x605) {
+      // An "SDO download" that makes the node listen to an RPDO as well, answered at once: the
+      // new filter leaves in the same write as the answer, and first.
+      listened.push_back(0x205);
+      ASSERT_TRUE(node->Send(CanFrame::Data(0x585, {0x60})));
+    }
+  });
+  master->OnReceive([&](const CanFrame& f, BusTime) {
+    master_got.push_back(ToCandump(f));
+    if (f.id == 0x585) {
+      ASSERT_TRUE(master->Send(CanFrame::Data(0x205, {0x42})));  // reacts at once
+    }
+  });
+  // The node's first write carries its filter: once the master hears it, the filter is in place.
+  ASSERT_TRUE(node->Send(CanFrame::Data(0x705, {0x7F})));
+  ASSERT_TRUE(RunUntil([&] { return master_got.size() == 1; }));
+  node_got.clear();
+  const auto filtered_before = server.Stats().filtered_frames;
+  ASSERT_TRUE(master->Send(CanFrame::Data(0x181, {1})));     // another node's TPDO: not for it
+  ASSERT_TRUE(master->Send(CanFrame::Data(0x205, {0x41})));  // its RPDO, not configured yet
+  ASSERT_TRUE(master->Send(CanFrame::Data(0x605, {0x23, 0x00, 0x14, 0x01})));
+  ASSERT_TRUE(RunUntil([&] { return node_got.size() >= 2; })) << node_got.size();
+  EXPECT_EQ(node_got, (std::vector<std::string>{"605#23001401", "205#42"}));
+  EXPECT_EQ(server.Stats().filtered_frames - filtered_before, 2u);
+  EXPECT_EQ(node->Stats().rx_frames, 2u);  // nothing else woke it
+}
+
 /// A PortSink for a port driven from the test itself.
 struct NullSink : broker::PortSink {
   void Deliver(std::span<const broker::TimedFrame>) override {}

@@ -39,8 +39,10 @@ class Rpdo {
   std::size_t number() const { return number_; }
   PdoConfig& config() { return config_; }
   const PdoConfig& config() const { return config_; }
-  /// Valid, usable and operational: frames of its COB-ID are taken (an acceptance filter asks).
-  bool Listening() const { return Active(); }
+  /// Valid and usable, in whatever NMT state: frames of its COB-ID may be taken (an acceptance
+  /// filter asks; it follows the configuration only, so that an NMT start, which no reply follows,
+  /// never leaves a filter behind in real time).
+  bool Listening() const { return config_.Usable(); }
 
   /// After a write of either record: re-reads it. A new event timer value moves the running
   /// deadline to last reception + new value; any other change restarts reception.

@@ -38,8 +38,9 @@ class Tpdo {
   std::size_t number() const { return number_; }
   PdoConfig& config() { return config_; }
   const PdoConfig& config() const { return config_; }
-  /// Valid, usable and operational: frames of its COB-ID are taken (an acceptance filter asks).
-  bool Listening() const { return Active(); }
+  /// Valid, usable and mapped, in whatever NMT state: remote frames of its COB-ID may be taken
+  /// (an acceptance filter asks; it follows the configuration only, as Rpdo::Listening).
+  bool Listening() const { return config_.Usable() && config_.mapping().Bits() > 0; }
 
   /// After a write of either record: re-reads it. A new event timer value re-arms the timer from
   /// now; any other change restarts the TPDO (timers, SYNC count, pending events).

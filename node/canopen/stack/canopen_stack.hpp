@@ -104,10 +104,12 @@ class CanopenStack final : private CommErrorSink {
   ParameterStore* store() { return store_.get(); }
   /// The last controller event (state, TEC, REC) reported by the bus port.
   const ControllerEvent& Controller() const { return controller_; }
-  /// The 11-bit identifiers the stack listens to now, sorted: a frame with another 11-bit
-  /// identifier would change nothing (an acceptance filter; orchestrator/broker/README.md "Virtual
-  /// time"). Extended frames are not covered: they always reach the stack. Follows the NMT state,
-  /// the LSS configuration and the communication objects as they are now.
+  /// The 11-bit identifiers the stack's configuration makes it listen to, sorted: a frame with
+  /// another 11-bit identifier would change nothing in any NMT state (an acceptance filter;
+  /// orchestrator/broker/README.md "Acceptance filters"). Extended frames are not covered: they
+  /// always reach the stack. Follows the LSS configuration and the communication objects, not the
+  /// NMT state: a filter changes only with a write, an LSS command or a reset, each of which the
+  /// node answers, so in real time the new filter reaches the broker with that answer.
   std::vector<std::uint32_t> ListenedIds() const;
 
   /// Local NMT transition (device logic, tests). Same effect as the NMT command.

@@ -1,5 +1,7 @@
 // RPDO reception: CiA 301 v4.2 §7.2.2 and §7.5.2.35/36 (1400h+/1600h+); length errors and the
 // RPDO deadline as in facts §4 (CANopenNode CO_PDO_receive / CO_RPDO_process).
+#include <algorithm>
+
 #include "tests/unit/pdo/pdo_fixture.hpp"
 
 namespace canfleet::canopen::test_pdo {
@@ -33,6 +35,28 @@ TEST_F(RpdoTest, EventRpdoIsWrittenAtOnceAndListenersRun) {
   EXPECT_EQ(pdo->Counters().rpdo_received, 1u);
   EXPECT_EQ(pdo->Counters().rpdo_applied, 1u);
   EXPECT_TRUE(errors.events.empty());
+}
+
+// The acceptance filter (orchestrator/broker/README.md "Acceptance filters") follows the
+// configuration, not the NMT state: a valid RPDO is listened to before the NMT start too, since
+// no reply follows that start to carry a new filter; an invalid COB-ID (CiA 301 §7.5.2.35,
+// bit 31) takes it out.
+TEST_F(RpdoTest, ItsIdentifierIsListenedToInEveryNmtStateWhileItIsValid) {
+  Start();
+  MapRpdo1();
+  auto listened = [&] {
+    std::vector<std::uint32_t> ids;
+    pdo->AddListenedIds(ids);
+    return std::find(ids.begin(), ids.end(), 0x205u) != ids.end();
+  };
+  EXPECT_TRUE(listened()) << "pre-operational";
+  Operational();
+  EXPECT_TRUE(listened()) << "operational";
+  pdo->SetNmtState(NmtState::kStopped);
+  EXPECT_TRUE(listened()) << "stopped";
+  ASSERT_EQ(W32(0x1400, 1, static_cast<std::uint32_t>(od.GetUnsigned(0x1400, 1)) | kPdoCobIdInvalid),
+            SdoAbort::kNone);
+  EXPECT_FALSE(listened()) << "invalid";
 }
 
 // Fewer bytes than mapped: nothing is written, EMCY 8210h once; the next right frame clears it.
