@@ -12,7 +12,8 @@
 #                           seeds, so a fresh clone starts deep
 #   $CANFLEET_FUZZ_CACHE/<target>/   the growing corpus, kept across runs outside the clone as
 #                           ccache keeps its cache; default ${XDG_CACHE_HOME:-$HOME/.cache}/canfleet-fuzz.
-#                           <target>.executions there sums the executions of every run.
+#   fuzz/README.md's table  the ledger: each long run adds its executions to its target's total
+#                           there, so the total counts every long run committed, on any machine.
 # Environment: FUZZ_JOBS (build jobs, default nproc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -100,8 +101,9 @@ for name in "${names[@]}"; do
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")
   files=$(find "$corpus" -type f | wc -l)
-  total=$(($(cat "$cache/$name.executions" 2>/dev/null || echo 0) + ${executions:-0}))
-  echo "$total" >"$cache/$name.executions"
+  # The total so far: the ledger's row for the target (fuzz/README.md), 0 for a new target.
+  before=$(sed -n "s/^| $name | [0-9,]* | \([0-9,]*\) |.*/\1/p" fuzz/README.md | tr -d , | head -1)
+  total=$((${before:-0} + ${executions:-0}))
   echo "fuzz: $name executions ${executions:-?} (in total $total), coverage ${cov:-?} edges, ${ft:-?} features, corpus $files files"
   printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "${executions:-0}" "$total" "${cov:-0}" "${ft:-0}" "$files" >>"$figures"
 done
