@@ -19,7 +19,9 @@ figures.
 
 A bus has at most 127 node-IDs: --buses K spreads the nodes over K buses of the one broker
 (can0, can1, ...; node-IDs 1.. on each, each consuming its neighbour's heartbeat on its own bus),
-so 500 nodes run as --nodes 500 --buses 4.
+so 500 nodes run as --nodes 500 --buses 4. A variant with two CAN ports (the data logger) needs
+--ports 2: every node then has port 1 on can0 and port 2 on can1, and runs at its factory settings
+(the compiled-in EDS, no --eds: the heartbeat and consumer above are not set).
 
   bench/idle/idle_bench.py --bin build/ [--nodes 10] [--buses 1] [--window 30] [--settle 5]
                            [--operational] [--no-telemetry] [--monitor] [--device quad-controller]
@@ -168,6 +170,8 @@ def main():
     ap.add_argument("--bin", required=True, help="build folder with canfleet-node and canfleet-broker")
     ap.add_argument("--nodes", type=int, default=10)
     ap.add_argument("--buses", type=int, default=1, help="spread the nodes over this many buses")
+    ap.add_argument("--ports", type=int, choices=(1, 2), default=1,
+                    help="2: two-port nodes on can0 and can1, at factory settings")
     ap.add_argument("--window", type=float, default=30.0, help="measurement window, seconds")
     ap.add_argument("--settle", type=float, default=5.0, help="seconds between start and measurement")
     ap.add_argument("--bitrate", default="250k")
@@ -178,19 +182,30 @@ def main():
     ap.add_argument("--monitor", action="store_true",
                     help="listen on the bus: start time, heartbeat periods, EMCY 8130h")
     args = ap.parse_args()
+    if args.ports == 2:
+        if args.buses != 1 or args.operational or args.eds or args.monitor:
+            sys.exit("--ports 2 runs every node on can0 and can1 at factory settings: "
+                     "no --buses, --operational, --eds, --monitor")
+        args.buses = 2
     if args.buses < 1 or not 1 <= args.nodes <= 127 * args.buses:
         sys.exit("--nodes: 1..127 per bus (--buses)")
     per_bus = -(-args.nodes // args.buses)  # ceiling
     bus_names = [f"can{b}" for b in range(args.buses)]
     # Node k (0-based) is on bus k // per_bus with node-ID k % per_bus + 1.
     placement = [(k // per_bus, k % per_bus + 1) for k in range(args.nodes)]
+    if args.ports == 2:  # every node on both buses; the placement names its node-ID
+        per_bus = args.nodes
+        placement = [(0, k + 1) for k in range(args.nodes)]
     on_bus = [sum(1 for b, _ in placement if b == bus) for bus in range(args.buses)]
 
     node_bin = find_binary(args.bin, "canfleet-node")
     broker_bin = find_binary(args.bin, "canfleet-broker")
-    eds = set_default(base_eds(node_bin, args.device, args.eds), "1017", "500")
-    if args.operational:
-        eds = set_default(eds, "5555", "1")
+    if args.ports == 2:
+        eds = None
+    else:
+        eds = set_default(base_eds(node_bin, args.device, args.eds), "1017", "500")
+        if args.operational:
+            eds = set_default(eds, "5555", "1")
 
     work = tempfile.mkdtemp(prefix="canfleet-idle-")
     procs = []
@@ -219,6 +234,15 @@ def main():
         nodes = []
         launched = time.monotonic()
         for k, (b, i) in enumerate(placement):
+            if args.ports == 2:
+                cmd = [node_bin, "--device", args.device, "--node-id", str(i), "--node-id", str(i),
+                       "--bus", f"can0@unix://{sock}", "--bus", f"can1@unix://{sock}", "--log-level", "warn"]
+                if args.no_telemetry:
+                    cmd.append("--no-telemetry")
+                nodes.append(subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL))
+                procs.append(nodes[-1])
+                continue
             neighbour = i % on_bus[b] + 1
             node_eds = eds
             if on_bus[b] > 1:
@@ -262,7 +286,8 @@ def main():
             else f"can0:{args.bitrate}"
         print(f"{args.nodes} x {args.device} on {where}, "
               f"{'operational (TPDOs every 100 ms)' if args.operational else 'pre-operational'}, "
-              f"heartbeat 500 ms + consumer 1500 ms, telemetry {'off' if args.no_telemetry else 'on'}, "
+              f"{'two ports (can0, can1), factory settings' if args.ports == 2 else 'heartbeat 500 ms + consumer 1500 ms'}, "
+              f"telemetry {'off' if args.no_telemetry else 'on'}, "
               f"window {elapsed:.1f} s, load average {load_start:.2f} at its start, {os.getloadavg()[0]:.2f} at its end")
         print(f"  node CPU % of a core (stat):      {summary([r[0] for r in per_node])}")
         print(f"  node CPU % of a core (schedstat): {summary([r[1] for r in per_node])}")
