@@ -73,8 +73,9 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
   -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache >/dev/null
 cmake --build build-fuzz -j "${FUZZ_JOBS:-$(nproc)}" --target "${names[@]/#/fuzz_}"
 
-figures=build-fuzz/figures.tsv
-: >"$figures"
+# One figures file per invocation: two long runs of different targets may run side by side (one
+# per core), each adding its rows to fuzz/README.md under a lock at the end.
+figures=$(mktemp build-fuzz/figures.XXXXXX.tsv)
 failed=()
 for name in "${names[@]}"; do
   [ "$seconds" = 0 ] && break
@@ -159,7 +160,10 @@ for name in "${names[@]}"; do
   sed -i "s|^$name\t.*|&\t$kept|" "$figures"
 done
 
-# The table in fuzz/README.md: a row per target, replaced for the targets of this run.
+# The table in fuzz/README.md: a row per target, replaced for the targets of this run (under a
+# lock, so that a run beside this one does not write its rows at the same time).
+exec 9>build-fuzz/readme.lock
+flock 9
 python3 - "$figures" "$minutes" <<'EOF'
 import datetime
 import re

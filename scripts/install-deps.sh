@@ -39,7 +39,7 @@ programs=(
   xz:xz-utils zstd:zstd gzip:gzip                                          # vm-can-test.sh: kernel modules, initramfs
   apt-get:apt apt-cache:apt dpkg-deb:dpkg                                  # vm-can-test.sh: kernel download
   debootstrap:debootstrap                                                  # scripts/docker-base-image.sh
-  timeout:coreutils sha256sum:coreutils mktemp:coreutils awk:mawk sed:sed find:findutils tar:tar
+  timeout:coreutils sha256sum:coreutils mktemp:coreutils awk:mawk sed:sed find:findutils tar:tar flock:util-linux
 )
 
 if [ "${1:-}" = "--check" ]; then
