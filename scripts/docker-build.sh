@@ -2,7 +2,8 @@
 # Builds the canfleet image (docker/Dockerfile) from this tree, without any container registry.
 #
 #   scripts/docker-build.sh [--tag IMAGE] [--base IMAGE] [--builder auto|buildkit|classic]
-#                           [--src DIR] [--keep-going] [--no-cache] [-- extra docker build args]
+#                           [--src DIR | --prebuilt BUILD] [--keep-going] [--no-cache]
+#                           [-- extra docker build args]
 #
 #   --tag IMAGE     image to produce (default $CANFLEET_IMAGE or canfleet:dev)
 #   --base IMAGE    BASE_IMAGE build argument (default $CANFLEET_BASE_IMAGE or
@@ -11,6 +12,12 @@
 #   --builder       auto (default): BuildKit (cache mounts for apt and ccache) when some docker
 #                   client here can use it, else the classic builder with the mounts stripped
 #   --src DIR       build context (default: this repository); e.g. a `git worktree` of HEAD
+#   --prebuilt BUILD  ship the executables of BUILD, a CMake build folder of this tree on this host
+#                   (built already, or built now), instead of compiling them again in the image:
+#                   what scripts/test.sh does, so the image holds the binaries the suite has just
+#                   tested. Needs BuildKit and a host of the base image's system (Debian 12), so
+#                   the binaries load the same libraries there (docker/stage.sh finds their
+#                   packages); otherwise it says so and builds from source.
 #   --keep-going    ship the executables that compile, warn about the others (in-progress tree)
 #   --no-cache      passed to docker build
 # Prints the build time and the image size. Exits non-zero with the reason when docker is missing.
@@ -21,6 +28,7 @@ tag="${CANFLEET_IMAGE:-canfleet:dev}"
 base="${CANFLEET_BASE_IMAGE:-canfleet/debian:bookworm}"
 builder=auto
 src="$repo"
+prebuilt=""
 extra=()
 
 say() { echo "docker-build: $*"; }
@@ -32,6 +40,7 @@ while [ $# -gt 0 ]; do
     --base) base="${2:?}"; shift ;;
     --builder) builder="${2:?}"; shift ;;
     --src) src="$(cd "${2:?}" && pwd)"; shift ;;
+    --prebuilt) prebuilt="$(cd "${2:?}" && pwd)" || die "--prebuilt: no folder '$2'"; shift ;;
     --keep-going) extra+=(--build-arg CANFLEET_KEEP_GOING=1) ;;
     --no-cache) extra+=(--no-cache) ;;
     --) shift; extra+=("$@"); break ;;
@@ -90,7 +99,9 @@ if [ "$builder" = classic ]; then
   # Cache mounts are only caches: without BuildKit, drop them.
   mkdir -p "$repo/build-docker"
   dockerfile="$repo/build-docker/Dockerfile.classic"
-  sed -E 's/^RUN( --mount=[^ ]+)+/RUN/' "$src/docker/Dockerfile" >"$dockerfile"
+  # It also builds every stage: drop the prebuilt one, whose prebuilt/ folder is not in this context.
+  sed -E -e 's/^RUN( --mount=[^ ]+)+/RUN/' -e '/^# >>> prebuilt/,/^# <<< prebuilt/d' \
+    "$src/docker/Dockerfile" >"$dockerfile"
   args=(-f "$dockerfile")
   export DOCKER_BUILDKIT=0
 else
@@ -98,6 +109,31 @@ else
   args+=(--progress=plain)
 fi
 
+if [ -n "$prebuilt" ]; then
+  [ -f "$prebuilt/CMakeCache.txt" ] || die "--prebuilt: $prebuilt is not a CMake build folder"
+  # The binaries were linked here: they run in the image only if it is the same system.
+  host_os=$(. /etc/os-release && echo "$ID $VERSION_ID")
+  image_os=$(docker run --rm "$base" sh -c '. /etc/os-release && echo "$ID $VERSION_ID"') ||
+    die "could not read /etc/os-release in $base"
+  if [ "$builder" != buildkit ]; then
+    say "--prebuilt needs BuildKit (the classic builder compiles the build stage anyway): building from source"
+    prebuilt=""
+  elif [ "$host_os" != "$image_os" ]; then
+    say "--prebuilt: this host is $host_os but $base is $image_os: building from source"
+    prebuilt=""
+  fi
+fi
+if [ -n "$prebuilt" ]; then
+  context="$repo/build-docker/prebuilt-context"
+  rm -rf "$context"
+  mkdir -p "$context"
+  cp "$src/docker/Dockerfile" "$context/Dockerfile"
+  say "staging the executables of $prebuilt (docker/stage.sh)"
+  "$src/docker/stage.sh" "$src" "$prebuilt" "$context/prebuilt" 2>&1 | sed 's/^/docker-build: /' ||
+    die "docker/stage.sh failed on $prebuilt"
+  args=(-f "$context/Dockerfile" --progress=plain --build-arg BINARIES_FROM=prebuilt)
+  src="$context"
+fi
 say "building $tag from $src (base $base, $builder builder via $cli)"
 previous=$(docker image inspect -f '{{.Id}}' "$tag" 2>/dev/null || true)
 start=$(date +%s)

@@ -29,8 +29,9 @@ ctest --test-dir build -j "$jobs" --output-on-failure
 # The scenario library's JUnit report (ctest's canfleet_scenario_library), for CI to keep.
 echo "scenario library JUnit report: build/scenarios-junit.xml"
 
-# The container fleet on the real Docker engine (docker/compose.yaml): builds canfleet:dev, checks
+# The container fleet on the real Docker engine (docker/compose.yaml): makes canfleet:dev of the
+# binaries just built and tested in build/ (--prebuilt: no second compile inside the image), checks
 # heartbeat loss on stop/kill/disconnect; prints "SKIPPED: <reason>" when no Docker engine answers.
-tests/docker/run.sh
+tests/docker/run.sh --prebuilt build
 
 scripts/fuzz.sh "${FUZZ_SECONDS:-15}"

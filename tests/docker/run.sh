@@ -5,8 +5,10 @@
 # operational, silence quad-5 three ways and check what its heartbeat consumers report, bring it
 # back each time, tear everything down (always, also on failure or Ctrl-C).
 #
-#   tests/docker/run.sh [--no-build] [--keep]
+#   tests/docker/run.sh [--no-build | --prebuilt BUILD] [--keep]
 #     --no-build   use the existing image (default: scripts/docker-build.sh, fast when cached)
+#     --prebuilt BUILD  make the image of the executables in the build folder BUILD
+#                  (scripts/docker-build.sh --prebuilt): scripts/test.sh's way, no second compile
 #     --keep       leave the fleet running at the end (for a look; `scripts/docker-fleet.sh down`
 #                  with the printed CANFLEET_PROJECT removes it)
 # Environment: CANFLEET_DOCKER_SRC=DIR builds the image from DIR (scripts/docker-build.sh --src),
@@ -47,13 +49,20 @@ cd "$repo"
 
 build=1
 keep=0
-for arg in "$@"; do
-  case "$arg" in
+prebuilt=""
+while [ $# -gt 0 ]; do
+  case "$1" in
     --no-build) build=0 ;;
     --keep) keep=1 ;;
+    --prebuilt)
+      [ $# -ge 2 ] || { echo "tests/docker/run.sh: --prebuilt needs a build folder" >&2; exit 2; }
+      prebuilt=$2
+      shift
+      ;;
     -h | --help) awk 'NR > 1 && /^#/ {sub(/^# ?/, ""); print; next} NR > 1 {exit}' "$0"; exit 0 ;;
-    *) echo "tests/docker/run.sh: unknown argument '$arg'" >&2; exit 2 ;;
+    *) echo "tests/docker/run.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
+  shift
 done
 
 log() { echo "docker-test: $*"; }
@@ -175,7 +184,8 @@ fi
 # ---- image ---------------------------------------------------------------------------------------
 if [ "$build" = 1 ]; then
   t=$(date +%s)
-  scripts/docker-build.sh --tag "$CANFLEET_IMAGE" ${CANFLEET_DOCKER_SRC:+--src "$CANFLEET_DOCKER_SRC"} 2>&1 | grep -E '^docker-build:|ERROR|error:' || true
+  scripts/docker-build.sh --tag "$CANFLEET_IMAGE" ${CANFLEET_DOCKER_SRC:+--src "$CANFLEET_DOCKER_SRC"} \
+    ${prebuilt:+--prebuilt "$prebuilt"} 2>&1 | grep -E '^docker-build:|ERROR|error:' || true
   [ "${PIPESTATUS[0]}" = 0 ] || fail "scripts/docker-build.sh failed"
   log "image $CANFLEET_IMAGE built in $(elapsed "$t")"
 fi
