@@ -10,6 +10,7 @@
 
 #include "node/canopen/eds/eds_number.hpp"
 #include "node/canopen/eds/eds_value.hpp"
+#include "node/canopen/od/types.hpp"
 #include "node/devices/dictionary/table_facts.hpp"
 #include "node/devices/dictionary/table_lines.hpp"
 
@@ -112,22 +113,20 @@ DataType ParseType(const Row& row) {
            "\"" + std::string(text) + "\" is not a CiA 301 data type (UNSIGNED8, INTEGER16, REAL32...)");
 }
 
-bool IsStringType(DataType type) {
-  return type == DataType::kVisibleString || type == DataType::kOctetString ||
-         type == DataType::kUnicodeString || type == DataType::kDomain;
-}
-
 /// A cell's values for `count` sub-objects: one value for all, or a list ("40*7,10000*5").
 std::vector<std::string_view> ValueList(const Row& row, Column column, DataType type, std::size_t count) {
   std::string_view text = row[column];
-  if (IsStringType(type) || text.find(',') == std::string_view::npos) {
+  // A string is one value, commas and stars included.
+  const bool one_value = canopen::IsVariableLength(type);
+  if (one_value || text.find(',') == std::string_view::npos) {
     std::string_view one = text;
     auto star = one.rfind('*');
-    std::optional<unsigned> repeat =
-        star == std::string_view::npos ? std::nullopt : Decimal(one.substr(star + 1));
-    if (!IsStringType(type) && repeat) {
-      if (*repeat != count)
-        row.Fail(column, "\"" + std::string(text) + "\" gives " + std::to_string(*repeat) + " values for " +
+    const std::optional<unsigned> repeat =
+        one_value || star == std::string_view::npos ? std::nullopt : Decimal(one.substr(star + 1));
+    if (repeat.has_value()) {
+      const unsigned times = repeat.value();
+      if (times != count)
+        row.Fail(column, "\"" + std::string(text) + "\" gives " + std::to_string(times) + " values for " +
                              std::to_string(count) + " sub-objects");
       one = one.substr(0, star);
     }
@@ -281,7 +280,7 @@ class TableReader {
       row.Fail(kPdo, "\"" + std::string(row[kPdo]) + "\" is not 0 or 1");
     std::size_t n = count == 0 ? 1 : count;
     std::size_t at = count == 0 ? 0 : position;
-    if (row[kDefault].empty() && !IsStringType(type)) row.Fail(kDefault, "a default is needed");
+    if (row[kDefault].empty() && !canopen::IsVariableLength(type)) row.Fail(kDefault, "a default is needed");
     canopen::EdsValue value = ParseValue(row, kDefault, type, ValueList(row, kDefault, type, n)[at]);
     SubObject made =
         canopen::MakeSubObject(SubName(name, sub, ordinal), type, *access, value.bytes, row[kPdo] == "1");
@@ -290,6 +289,11 @@ class TableReader {
     for (auto [column, limit] :
          {std::pair{kLow, &SubObject::low_limit}, std::pair{kHigh, &SubObject::high_limit}}) {
       if (row[column].empty()) continue;
+      // As in CiA 306 (and our EDS reader, which ignores them in a foreign file): limits bound
+      // numbers. In our own table one on a string is a mistake, and it would not survive the EDS.
+      if (canopen::IsVariableLength(type)) {
+        row.Fail(column, "a limit bounds a number; " + std::string(canopen::ToString(type)) + " has none");
+      }
       canopen::EdsValue bound = ParseValue(row, column, type, ValueList(row, column, type, n)[at]);
       made.*limit = bound.bytes;
       if (bound.adds_node_id) {

@@ -180,6 +180,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"| 2000 | VAR | a\x04"
                 "b | U8 | rw | 0 | 0 | | | 3 |\n",
                 "t.od:1: a control character (04h) in a line: tables are text"},
+        // Found by fuzz/od_table: a limit on a string was kept in the table, dropped by the EDS
+        // reader (CiA 306 limits bound numbers), so the generated EDS read back differently.
+        BadCase{"| 6110 | VAR | s | VISIBLE_STRING | rw | 0 | x | \xff | | 3 |\n",
+                "t.od:1: column \"low\": a limit bounds a number; VISIBLE_STRING has none"},
+        BadCase{"| 6110 | VAR | d | DOMAIN | rw | 0 | | | 1 | 3 |\n",
+                "t.od:1: column \"high\": a limit bounds a number; DOMAIN has none"},
         BadCase{"just words\n",
                 "t.od:1: a line is a row (|...|), a fact (@key value), @for/@end or a # comment"},
         BadCase{"# nothing\n", "t.od:0: the table has no objects"}));
