@@ -73,8 +73,9 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
   -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache >/dev/null
 cmake --build build-fuzz -j "${FUZZ_JOBS:-$(nproc)}" --target "${names[@]/#/fuzz_}"
 
-# One figures file per invocation: two long runs of different targets may run side by side (one
-# per core), each adding its rows to fuzz/README.md under a lock at the end.
+# One figures file and one log per target per invocation: two long runs may run side by side (one
+# per core), of different targets or of the same one (they share its cache corpus, as libFuzzer's
+# own -jobs do); each minimises and adds its rows to fuzz/README.md under a lock at the end.
 figures=$(mktemp build-fuzz/figures.XXXXXX.tsv)
 failed=()
 for name in "${names[@]}"; do
@@ -86,7 +87,7 @@ for name in "${names[@]}"; do
   for d in "fuzz/corpus/$name" "fuzz/seeds/$name"; do
     [ -d "$d" ] && dirs+=("$d")
   done
-  log=build-fuzz/fuzz_$name.log
+  log=$(mktemp "build-fuzz/fuzz_$name.XXXXXX.log")
   echo "fuzz: $name for ${seconds}s (corpus $corpus)"
   # -timeout: an input that runs 25 s is a hang (the slowest seed takes well under a second).
   if ! "$bin" -max_total_time="$seconds" -timeout=25 -print_final_stats=1 "${dirs[@]}" 2>"$log"; then
@@ -102,11 +103,8 @@ for name in "${names[@]}"; do
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$status")
   files=$(find "$corpus" -type f | wc -l)
-  # The total so far: the ledger's row for the target (fuzz/README.md), 0 for a new target.
-  before=$(sed -n "s/^| $name | [0-9,]* | \([0-9,]*\) |.*/\1/p" fuzz/README.md | tr -d , | head -1)
-  total=$((${before:-0} + ${executions:-0}))
-  echo "fuzz: $name executions ${executions:-?} (in total $total), coverage ${cov:-?} edges, ${ft:-?} features, corpus $files files"
-  printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "${executions:-0}" "$total" "${cov:-0}" "${ft:-0}" "$files" >>"$figures"
+  echo "fuzz: $name executions ${executions:-?}, coverage ${cov:-?} edges, ${ft:-?} features, corpus $files files"
+  printf '%s\t%s\t%s\t%s\t%s\n' "$name" "${executions:-0}" "${cov:-0}" "${ft:-0}" "$files" >>"$figures"
 done
 
 [ -n "$minutes" ] || exit 0
@@ -117,6 +115,7 @@ done
 # one are kept. (-merge=1's own choice keeps every input with a new feature, i.e. hit-count bucket:
 # ten times more files for the same edges.)
 minimise() { # TARGET: rewrites fuzz/corpus/TARGET, prints the number of files kept
+  # Under the lock below: a run of the same target beside this one minimises after or before it.
   local name=$1 bin=build-fuzz/fuzz/fuzz_$1 work=build-fuzz/merge/$1 ctl=build-fuzz/merge/$1.ctl
   rm -rf "$work" "$ctl"
   mkdir -p "$work" "build-fuzz/merge/$name.new"
@@ -152,6 +151,10 @@ if [ "$minutes" = 0 ]; then # --minutes 0: only re-minimise (after a change of t
   exit 0
 fi
 
+# The minimised corpus and the table in fuzz/README.md, under a lock: a run beside this one (of
+# another target or the same) does not minimise or write at the same time.
+exec 9>build-fuzz/readme.lock
+flock 9
 for name in "${names[@]}"; do
   case " ${failed[*]} " in *" $name "*) continue ;; esac # a failed target's corpus waits for its fix
   kept=$(minimise "$name") || exit 1
@@ -160,10 +163,9 @@ for name in "${names[@]}"; do
   sed -i "s|^$name\t.*|&\t$kept|" "$figures"
 done
 
-# The table in fuzz/README.md: a row per target, replaced for the targets of this run (under a
-# lock, so that a run beside this one does not write its rows at the same time).
-exec 9>build-fuzz/readme.lock
-flock 9
+# The table: a row per target, replaced for the targets of this run; the total is the one in the
+# table now (read under the lock, so a run of the same target that ended meanwhile is counted) plus
+# this run's executions.
 python3 - "$figures" "$minutes" <<'EOF'
 import datetime
 import re
@@ -182,8 +184,11 @@ for line in table.splitlines():
         rows[cells[0]] = cells
 today = datetime.date.today().isoformat()
 for line in open(figures_path):
-    name, runs, total, cov, ft, files, kept = line.rstrip("\n").split("\t")
-    rows[name] = [name, f"{int(runs):,}", f"{int(total):,}", cov, ft, files, kept, f"{minutes} min", today]
+    name, runs, cov, ft, files, kept = line.rstrip("\n").split("\t")
+    total = int(rows[name][2].replace(",", "")) if name in rows else 0
+    total += int(runs)
+    rows[name] = [name, f"{int(runs):,}", f"{total:,}", cov, ft, files, kept, f"{minutes} min", today]
+    print(f"fuzz: {name} executions in total {total:,}")
 header = ("| target | executions (this run) | executions (in total) | coverage (edges) | features"
           " | corpus (files) | fuzz/corpus (files) | run | date |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n")
 body = "".join("| " + " | ".join(rows[k]) + " |\n" for k in sorted(rows))
