@@ -117,10 +117,14 @@ done
 minimise() { # TARGET: rewrites fuzz/corpus/TARGET, prints the number of files kept
   # Under the lock below: a run of the same target beside this one minimises after or before it.
   local name=$1 bin=build-fuzz/fuzz/fuzz_$1 work=build-fuzz/merge/$1 ctl=build-fuzz/merge/$1.ctl
-  rm -rf "$work" "$ctl"
+  local snapshot=build-fuzz/merge/$1.cache
+  rm -rf "$work" "$ctl" "$snapshot"
   mkdir -p "$work" "build-fuzz/merge/$name.new"
   [ -d "fuzz/seeds/$name" ] && cp "fuzz/seeds/$name"/* "$work"/
-  local from=("$cache/$name")
+  # A snapshot of the cache corpus (hard links): a run of the same target still fuzzing beside this
+  # one replaces inputs it reduces, and the merge must not look for a file that has gone since.
+  cp -al "$cache/$name" "$snapshot" 2>/dev/null || { rm -rf "$snapshot" && cp -a "$cache/$name" "$snapshot"; }
+  local from=("$snapshot")
   [ -d "fuzz/corpus/$name" ] && from+=("fuzz/corpus/$name")
   "$bin" -merge=1 -timeout=25 -merge_control_file="$ctl" "$work" "${from[@]}" 2>"build-fuzz/merge_$name.log" || {
     tail -30 "build-fuzz/merge_$name.log" >&2
@@ -139,7 +143,7 @@ for line in lines[2 + count:]:
         data = open(paths[int(parts[1])], "rb").read()
         open(sys.argv[2] + "/" + hashlib.sha1(data).hexdigest(), "wb").write(data)
 PY
-  rm -rf "fuzz/corpus/$name"
+  rm -rf "fuzz/corpus/$name" "$snapshot"
   mv "build-fuzz/merge/$name.new" "fuzz/corpus/$name"
   find "fuzz/corpus/$name" -type f | wc -l
 }
