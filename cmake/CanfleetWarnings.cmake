@@ -25,6 +25,7 @@ function(canfleet_unit_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main canfleet_warnings)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+  set_property(GLOBAL APPEND PROPERTY CANFLEET_UNIT_AND_INTEGRATION_TESTS ${name})
 endfunction()
 
 # canfleet_integration_test(<name> SOURCES ... DEPS ...): real sockets, real time, another program
@@ -34,6 +35,7 @@ function(canfleet_integration_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main canfleet_warnings)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS integration TIMEOUT 300)
+  set_property(GLOBAL APPEND PROPERTY CANFLEET_UNIT_AND_INTEGRATION_TESTS ${name})
 endfunction()
 
 if(CANFLEET_FUZZ)

@@ -17,7 +17,8 @@ common=(-G Ninja -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHE
 
 if [ "$mode" = sanitize ]; then
   cmake -S . -B build-asan "${common[@]}" -DCMAKE_BUILD_TYPE=Debug -DCANFLEET_SANITIZE=ON >/dev/null
-  cmake --build build-asan -j "$jobs"
+  # Only the binaries of the tests it runs (tests/CMakeLists.txt): 391 of 438 compiles, 41 of 67 links.
+  cmake --build build-asan -j "$jobs" --target canfleet_unit_and_integration_tests
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   ctest --test-dir build-asan -L 'unit|integration' -j "$jobs" --output-on-failure
   exit 0
