@@ -148,6 +148,10 @@ PY
   find "fuzz/corpus/$name" -type f | wc -l
 }
 
+# The minimised corpus and the table in fuzz/README.md, under a lock: a run beside this one (of
+# another target or the same) does not minimise or write at the same time.
+exec 9>build-fuzz/readme.lock
+flock 9
 if [ "$minutes" = 0 ]; then # --minutes 0: only re-minimise (after a change of the cover rule)
   for name in "${names[@]}"; do
     echo "fuzz: $name minimised corpus: $(minimise "$name") files in fuzz/corpus/$name"
@@ -155,10 +159,6 @@ if [ "$minutes" = 0 ]; then # --minutes 0: only re-minimise (after a change of t
   exit 0
 fi
 
-# The minimised corpus and the table in fuzz/README.md, under a lock: a run beside this one (of
-# another target or the same) does not minimise or write at the same time.
-exec 9>build-fuzz/readme.lock
-flock 9
 for name in "${names[@]}"; do
   case " ${failed[*]} " in *" $name "*) continue ;; esac # a failed target's corpus waits for its fix
   kept=$(minimise "$name") || exit 1
