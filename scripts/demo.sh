@@ -31,8 +31,8 @@ cmake --build build -j "$(nproc)" --target canfleet canfleet-node
 bin=build/bin
 mkdir -p build/demo
 rm -f build/demo/ready
-# Telemetry stays on this machine (loopback, no multicast needed).
-export CYCLONEDDS_URI="file://$PWD/telemetry/cyclonedds-loopback.xml"
+# Telemetry stays on this machine: every canfleet program takes the loopback configuration built
+# in when given none, so `canfleet top` and `canfleet watch` in another terminal see this fleet.
 "$bin/canfleet" up "$topology" --ready-file build/demo/ready >build/demo/orchestrator.log 2>&1 &
 up=$!
 stop() {

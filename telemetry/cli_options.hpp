@@ -26,7 +26,8 @@ inline void AddDdsOptions(CLI::App& app, DdsOptions& options, DdsDiscovery disco
       ->capture_default_str();
   app.add_option("--dds-config", options.config_file,
                  "Cyclone DDS XML configuration (telemetry/cyclonedds-loopback.xml for one host, "
-                 "cyclonedds-default.xml in containers); default: $CYCLONEDDS_URI or Cyclone's defaults")
+                 "cyclonedds-default.xml in containers and across hosts); default: $CYCLONEDDS_URI, else the "
+                 "loopback configuration built in (every canfleet program on this host meets the others)")
       ->envname("CANFLEET_DDS_CONFIG")
       ->check(CLI::ExistingFile);
 }

@@ -57,17 +57,33 @@ constexpr const char* kMonitorsOnlyConfig =
 
 }  // namespace
 
+namespace {
+
+const char* CycloneddsUri() {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  return uri != nullptr && *uri != '\0' ? uri : nullptr;
+}
+
+}  // namespace
+
+std::string DescribeConfig(const DdsOptions& options) {
+  if (!options.config_file.empty()) return options.config_file;
+  if (const char* uri = CycloneddsUri()) return std::string("CYCLONEDDS_URI=") + uri;
+  return "the built-in loopback configuration (this host only)";
+}
+
 std::string CycloneConfig(const DdsOptions& options) {
+  // The domain is always created explicitly, which ignores CYCLONEDDS_URI: carry it over.
   std::string config;
   if (!options.config_file.empty()) {
     config = "file://" + options.config_file;
-  } else if (options.discovery == DdsDiscovery::kMonitorsOnly) {
-    // An explicit domain ignores CYCLONEDDS_URI: carry it over.
-    const char* uri = std::getenv("CYCLONEDDS_URI");
-    if (uri != nullptr) config = uri;
+  } else if (const char* uri = CycloneddsUri()) {
+    config = uri;
+  } else {
+    config = kLoopbackConfigXml;
   }
   if (options.discovery == DdsDiscovery::kMonitorsOnly) {
-    if (!config.empty()) config += ',';
+    config += ',';
     config += kMonitorsOnlyConfig;
   }
   return config;
@@ -95,8 +111,7 @@ std::shared_ptr<DomainRef> AcquireDomain(const DdsOptions& options, const std::s
   static std::mutex mutex;
   static std::map<std::uint32_t, std::weak_ptr<DomainRef>> domains;
   const std::lock_guard lock(mutex);
-  const std::string description =
-      options.config_file.empty() ? "the default configuration" : options.config_file;
+  const std::string description = DescribeConfig(options);
   if (auto existing = domains[options.domain_id].lock()) {
     if (existing->config() != config) {
       throw DdsError("domain " + std::to_string(options.domain_id) +
@@ -113,8 +128,7 @@ std::shared_ptr<DomainRef> AcquireDomain(const DdsOptions& options, const std::s
 }  // namespace
 
 Participant::Participant(const DdsOptions& options) {
-  const std::string config = CycloneConfig(options);
-  if (!config.empty()) domain_ = AcquireDomain(options, config);
+  domain_ = AcquireDomain(options, CycloneConfig(options));
   entity_ = Entity(CheckDds(dds_create_participant(options.domain_id, nullptr, nullptr),
                             "create participant on domain " + std::to_string(options.domain_id)));
 }

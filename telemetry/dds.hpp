@@ -84,15 +84,26 @@ enum class DdsDiscovery : std::uint8_t {
 struct DdsOptions {
   std::uint32_t domain_id = 0;
   /// Path of a Cyclone XML configuration (telemetry/cyclonedds-loopback.xml for one host,
-  /// telemetry/cyclonedds-default.xml in containers). Empty: Cyclone's own lookup
-  /// (the CYCLONEDDS_URI environment variable, else its built-in defaults).
+  /// telemetry/cyclonedds-default.xml in containers). Empty: the CYCLONEDDS_URI environment
+  /// variable, else the loopback configuration compiled in (kLoopbackConfigXml).
   std::string config_file;
   DdsDiscovery discovery = DdsDiscovery::kAll;
 };
 
-/// The Cyclone configuration `options` ask for, as dds_create_domain takes it: the file (or
-/// CYCLONEDDS_URI), followed by the announce-only settings for DdsDiscovery::kMonitorsOnly.
-/// Empty: Cyclone's defaults.
+/// telemetry/cyclonedds-loopback.xml, compiled in: the configuration of every canfleet program that
+/// is given none (no --dds-config, no CYCLONEDDS_URI). Every process of a fleet and every monitor on
+/// the host then meet over loopback with no setup: a `canfleet top` in a second terminal sees the
+/// fleet `canfleet up` started in the first. (Cyclone's own default, multicast on the first
+/// interface, met nothing of a fleet started with the loopback file, which the demo used.)
+extern const char* const kLoopbackConfigXml;
+
+/// Where the configuration of `options` comes from, for messages: the file, "CYCLONEDDS_URI" or
+/// "the built-in loopback configuration".
+std::string DescribeConfig(const DdsOptions& options);
+
+/// The Cyclone configuration `options` ask for, as dds_create_domain takes it: the file, else
+/// CYCLONEDDS_URI, else the built-in loopback configuration; followed by the announce-only
+/// settings for DdsDiscovery::kMonitorsOnly.
 std::string CycloneConfig(const DdsOptions& options);
 
 class DomainRef;

@@ -13,6 +13,7 @@
 
 #include "telemetry/cli_options.hpp"
 #include "telemetry/fleet_reader.hpp"
+#include "tools/telemetry/nothing_seen.hpp"
 
 namespace canfleet::tools {
 
@@ -301,6 +302,8 @@ int RunTop(const TopOptions& options) {
     reader.Poll();
     settings.now = std::chrono::system_clock::now();
     out << RenderFrame(view, settings) << std::flush;
+    if (view.nodes().empty() && view.buses().empty())
+      std::cerr << NothingSeenHint("canfleet top", options.dds) << '\n';
     return 0;
   }
 

@@ -8,6 +8,7 @@
 #include "telemetry/cli_options.hpp"
 #include "telemetry/fleet_reader.hpp"
 #include "tools/telemetry/event_format.hpp"
+#include "tools/telemetry/nothing_seen.hpp"
 
 namespace canfleet::tools {
 
@@ -40,12 +41,16 @@ void AddWatchOptions(CLI::App& app, WatchOptions& options) {
          "event types: emcy nmt controller error-register hb-consumer fault gone seen (default: all but "
          "seen)")
       ->delimiter(',');
-  app.add_flag("!--no-history", options.history, "skip events from before watch started");
+  app.add_flag("--history", options.history,
+               "also print the events from before watch started (kept by DDS, flagged [history]); default: "
+               "only what happens from now on");
+  // The default since issue 29; kept so that scripts written for the old default still run.
+  app.add_flag("!--no-history", options.history, "(the default) only events from now on")->group("");
   app.add_option("--count", options.count, "exit after this many events")->check(CLI::NonNegativeNumber);
   app.add_option_function<double>(
       "--timeout",
       [&options](double s) { options.timeout = std::chrono::milliseconds(static_cast<long>(s * 1000)); },
-      "exit after this many seconds (exit code 2 if --count events were not seen)");
+      "exit after this many seconds (exit code 1 if --count events were not seen by then)");
 }
 
 bool Selected(const FleetEvent& event, const WatchOptions& options) {
@@ -58,6 +63,8 @@ bool Selected(const FleetEvent& event, const WatchOptions& options) {
 
 int RunWatch(const WatchOptions& options) {
   std::ostream& out = options.out ? *options.out : std::cout;
+  std::ostream& err = options.err ? *options.err : std::cerr;
+  bool hinted = options.hint_after.count() == 0;
   const auto started = std::chrono::steady_clock::now();
   telemetry::Participant participant(options.dds);
   FleetView view(std::chrono::system_clock::now());
@@ -81,7 +88,11 @@ int RunWatch(const WatchOptions& options) {
       const auto left = options.timeout - std::chrono::duration_cast<std::chrono::milliseconds>(
                                               std::chrono::steady_clock::now() - started);
       if (left <= std::chrono::milliseconds::zero()) {
-        result = options.count > 0 && printed < options.count ? 2 : 0;
+        result = 0;
+        if (options.count > 0 && printed < options.count) {
+          err << "canfleet watch: " << printed << " of " << options.count << " events within the timeout\n";
+          result = 1;
+        }
         break;
       }
       wait = std::min(wait, left);
@@ -92,6 +103,11 @@ int RunWatch(const WatchOptions& options) {
       break;
     }
     reader.Poll();
+    if (!hinted && view.nodes().empty() && view.buses().empty() &&
+        std::chrono::steady_clock::now() - started >= options.hint_after) {
+      err << NothingSeenHint("canfleet watch", options.dds) << std::endl;
+      hinted = true;
+    }
     // One poll delivers topic by topic: print in time order.
     std::stable_sort(events.begin(), events.end(),
                      [](const auto& a, const auto& b) { return a.time < b.time; });

@@ -20,12 +20,19 @@ struct WatchOptions {
   int node = -1;      ///< only this node-id; -1 = all
   /// Event kinds to print; empty = all but "seen" (every node's first status is not news).
   std::set<EventKind> kinds{};
-  /// Print events that happened before watch started (delivered from DDS history), flagged.
-  bool history = true;
+  /// Also print events that happened before watch started (delivered from DDS history), flagged
+  /// "[history]" / "replay":true. Off by default: a user asking what happens now does not want the
+  /// boot-time EMCYs of an hour ago first (issue 29).
+  bool history = false;
   /// Exit with 0 after this many events (0 = never).
   int count = 0;
-  /// Exit after this long (0 = never); exit code 0, or 2 if `count` events were not seen by then.
+  /// Exit after this long (0 = never); exit code 0, or 1 if `count` events were not seen by then
+  /// (2 stays the code of bad arguments, README.md "The canfleet command line").
   std::chrono::milliseconds timeout{0};
+  /// After this long without any node or bus seen, say on stderr where watch looked and what to do
+  /// (0 = never). Nothing seen at all is a configuration mismatch far more often than a quiet fleet.
+  std::chrono::milliseconds hint_after{std::chrono::seconds(5)};
+  std::ostream* err = nullptr;  ///< default std::cerr
   std::ostream* out = nullptr;  ///< default std::cout
 };
 

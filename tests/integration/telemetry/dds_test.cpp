@@ -26,8 +26,26 @@ TEST(DdsError, NamesTheOperationAndTheReturnCode) {
 TEST(CycloneConfig, MonitorsSeeEverythingWithTheirConfigurationAsItIs) {
   EXPECT_EQ(CycloneConfig({.domain_id = 1, .config_file = "/etc/x.xml", .discovery = DdsDiscovery::kAll}),
             "file:///etc/x.xml");
+  ::setenv("CYCLONEDDS_URI", "file:///from/env.xml", 1);
   EXPECT_EQ(CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kAll}),
-            "");  // Cyclone's own lookup (CYCLONEDDS_URI, defaults)
+            "file:///from/env.xml");
+  ::unsetenv("CYCLONEDDS_URI");
+}
+
+// A user's second terminal: with no --dds-config and no CYCLONEDDS_URI, `canfleet top` must take
+// the configuration the fleet took (issue 29: it took Cyclone's multicast default and saw nothing
+// of a fleet on the loopback configuration).
+TEST(CycloneConfig, WithNothingSetEveryProgramTakesTheLoopbackConfigurationOfTheRepository) {
+  ::unsetenv("CYCLONEDDS_URI");
+  const std::string monitor =
+      CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kAll});
+  EXPECT_EQ(monitor, kLoopbackConfigXml);
+  EXPECT_NE(monitor.find("<NetworkInterface name=\"lo\"/>"), std::string::npos);
+  EXPECT_NE(monitor.find("<Peer address=\"127.0.0.1\"/>"), std::string::npos);
+  EXPECT_EQ(monitor.find("<?xml"), std::string::npos);  // one document among several: no prologue
+  EXPECT_TRUE(CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly})
+                  .starts_with(monitor + ",<CycloneDDS"));
+  EXPECT_EQ(DescribeConfig({}), "the built-in loopback configuration (this host only)");
 }
 
 TEST(CycloneConfig, WritersAppendTheAnnounceOnlySettings) {
@@ -46,8 +64,6 @@ TEST(CycloneConfig, WritersWithoutAFileKeepCycloneddsUri) {
       CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly});
   ::unsetenv("CYCLONEDDS_URI");
   EXPECT_TRUE(config.starts_with("file:///from/env.xml,<CycloneDDS")) << config;
-  EXPECT_TRUE(CycloneConfig({.domain_id = 1, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly})
-                  .starts_with("<CycloneDDS"));
 }
 
 TEST(CycloneConfig, AWriterStartsWithTheAnnounceOnlySettings) {
@@ -55,6 +71,16 @@ TEST(CycloneConfig, AWriterStartsWithTheAnnounceOnlySettings) {
   DdsOptions options = TestDds(27);
   options.discovery = DdsDiscovery::kMonitorsOnly;
   Participant writer(options);
+  EXPECT_GT(writer.handle(), 0);
+}
+
+// The built-in configuration is one Cyclone accepts, as a monitor's and as a writer's (the two
+// meeting across processes: tests/system/telemetry, "SecondTerminal").
+TEST(Participant, TheBuiltInConfigurationStartsAMonitorAndAWriter) {
+  ::unsetenv("CYCLONEDDS_URI");
+  Participant monitor({.domain_id = 71, .config_file = "", .discovery = DdsDiscovery::kAll});
+  EXPECT_GT(monitor.handle(), 0);
+  Participant writer({.domain_id = 72, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly});
   EXPECT_GT(writer.handle(), 0);
 }
 
