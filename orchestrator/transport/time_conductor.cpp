@@ -36,12 +36,12 @@ TimeConductor::~TimeConductor() {
   join_timer_.cancel();
 }
 
-void TimeConductor::Join(GrantedSession& session, const std::string& clock_id) {
+void TimeConductor::Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment) {
   Participant& p = participants_[clock_id];
   p.clock_id = clock_id;
   p.sessions.push_back(&session);
   p.pending = true;  // it may act now (boot-up): it takes part in the next round
-  sessions_[&session] = SessionState{&p, false};
+  sessions_[&session] = SessionState{&p, attachment, false};
   spdlog::debug("virtual time: {} joined at {} ({})", session.Label(), TimeText(Now()), clock_id);
   if (join_target_ && participants_.size() >= *join_target_) {
     spdlog::info("virtual time: {} node process(es) joined; time starts at {}", participants_.size(),
@@ -235,8 +235,18 @@ bool TimeConductor::OpenRound() {
   });
   stats_.grants += granted.size();
   granting_ = true;
-  for (GrantedSession* s : granted)
-    if (sessions_.contains(s)) s->SendGrant(now, until);
+  for (GrantedSession* s : granted) {
+    auto it = sessions_.find(s);
+    if (it == sessions_.end()) continue;  // left while an earlier grant was sent
+    // Each grant names every session of its process granted with it (all of them): the process
+    // reads its ports in no set order, and may read this grant before the HelloReply of another
+    // port joined before this round (orchestrator/broker/README.md "Virtual time",
+    // VirtualTimeClient::RunIfAllGranted).
+    attachments_.clear();
+    for (const GrantedSession* sibling : it->second.participant->sessions)
+      if (const std::uint64_t a = sessions_.at(sibling).attachment; a != 0) attachments_.push_back(a);
+    s->SendGrant(now, until, attachments_);
+  }
   granting_ = false;
   if (outstanding_ == 0) {
     CloseRound();

@@ -48,8 +48,10 @@ namespace canfleet::transport {
 class GrantedSession {
  public:
   virtual ~GrantedSession() = default;
-  /// Sends TimeGrant{now, until} after whatever was sent to the node since its last grant.
-  virtual void SendGrant(TimePoint now, TimePoint until) = 0;
+  /// Sends TimeGrant{now, until, attachments} after whatever was sent to the node since its last
+  /// grant. `attachments`: the Hello.clock_attachment of each of the process's sessions this round
+  /// grants (this one's included), by which the process knows which of its ports to wait for.
+  virtual void SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) = 0;
   /// The node did not answer in time: close the connection, saying why.
   virtual void Evict(const std::string& reason) = 0;
   /// For logs: "session 3 [quad-5 on can0, port 7]".
@@ -91,8 +93,9 @@ class TimeConductor {
 
   // --- sessions (NodeSession) ---
   /// A node process's port joins at the current time (call it between rounds: from AtBoundary).
-  /// `clock_id` groups the ports of one process; it is granted on all of them together.
-  void Join(GrantedSession& session, const std::string& clock_id);
+  /// `clock_id` groups the ports of one process; it is granted on all of them together, each grant
+  /// naming them all by their `attachment` (Hello.clock_attachment; 0: not named).
+  void Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment = 0);
   /// The session ends (disconnected, closed, evicted): its process is no longer waited for on it.
   void Leave(GrantedSession& session);
   /// Something was sent to the session's node at the current time: it takes part in the next round.
@@ -130,7 +133,8 @@ class TimeConductor {
   };
   struct SessionState {
     Participant* participant = nullptr;
-    bool granted = false;  ///< granted in the open round and not answered yet
+    std::uint64_t attachment = 0;  ///< the process's number for the connection (Hello.clock_attachment)
+    bool granted = false;          ///< granted in the open round and not answered yet
   };
   struct Submission {
     TimePoint time;
@@ -170,6 +174,7 @@ class TimeConductor {
   std::vector<Submission> submissions_;
   std::uint64_t next_sequence_ = 0;
   std::deque<std::function<void()>> boundary_;
+  std::vector<std::uint64_t> attachments_;  ///< the grant being sent names these (reused)
 
   bool round_open_ = false;
   bool advancing_ = false;
