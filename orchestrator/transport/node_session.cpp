@@ -342,7 +342,7 @@ void NodeSession::Accept(const wire::Hello& hello) {
   stats_->attached++;
   if (conductor != nullptr && hello.role() != wire::ROLE_MONITOR) {
     granted_ = true;
-    conductor->Join(*this, hello.clock_id(), hello.clock_attachment());
+    conductor->Join(*this, hello.clock_id(), hello.clock_attachment(), hello.clock_ports());
   }
   spdlog::info("{}: attached ({}{}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
                hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string(),

@@ -94,8 +94,10 @@ class TimeConductor {
   // --- sessions (NodeSession) ---
   /// A node process's port joins at the current time (call it between rounds: from AtBoundary).
   /// `clock_id` groups the ports of one process; it is granted on all of them together, each grant
-  /// naming them all by their `attachment` (Hello.clock_attachment; 0: not named).
-  void Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment = 0);
+  /// naming them all by their `attachment` (Hello.clock_attachment; 0: not named). `clock_ports`:
+  /// how many ports the process attaches (Hello.clock_ports; 0: not stated, one).
+  void Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment = 0,
+            std::uint32_t clock_ports = 1);
   /// The session ends (disconnected, closed, evicted): its process is no longer waited for on it.
   void Leave(GrantedSession& session);
   /// Something was sent to the session's node at the current time: it takes part in the next round.
@@ -113,9 +115,9 @@ class TimeConductor {
   /// Time stands still until as many Release() calls (the fleet holds it until its nodes joined).
   void Hold();
   void Release();
-  /// Holds time until `processes` node processes have joined (a fleet's nodes all start at the
-  /// same simulated time, whatever their real start-up order), or `timeout` of real time has
-  /// passed (then it says how many joined, and time goes on).
+  /// Holds time until `processes` node processes have joined, each on every port it attaches (a
+  /// fleet's nodes all start at the same simulated time, whatever their real start-up order), or
+  /// `timeout` of real time has passed (then it says how many joined, and time goes on).
   void HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout);
 
   TimePoint Now() const { return scheduler_.Now(); }
@@ -128,6 +130,7 @@ class TimeConductor {
   struct Participant {
     std::string clock_id;
     std::vector<GrantedSession*> sessions;
+    std::size_t ports = 1;          ///< how many the process attaches (Hello.clock_ports)
     std::optional<TimePoint> next;  ///< its next deadline, as last reported
     bool pending = false;           ///< something was sent to it at the current time
   };
@@ -145,6 +148,8 @@ class TimeConductor {
     CanFrame frame;
   };
 
+  /// Node processes joined on every port they attach.
+  std::size_t JoinedProcesses() const;
   void Kick();
   void StartRound();
   /// Opens a round to G; false when nothing is due (idle) or pacing delays it.

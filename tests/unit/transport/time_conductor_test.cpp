@@ -31,10 +31,10 @@ constexpr std::int64_t L = Ns(TimeConductor::kLookahead);
 class FakeNode final : public GrantedSession, public broker::PortSink {
  public:
   FakeNode(std::string name, TimeConductor& conductor, broker::Broker& broker, std::string clock = {},
-           std::string bus = "can0", std::uint64_t attachment = 0)
+           std::string bus = "can0", std::uint64_t attachment = 0, std::uint32_t clock_ports = 1)
       : name_(std::move(name)), bus_(std::move(bus)), conductor_(conductor), broker_(broker) {
     port = broker_.Attach(bus_, name_, *this);
-    conductor_.Join(*this, clock.empty() ? name_ : clock, attachment);
+    conductor_.Join(*this, clock.empty() ? name_ : clock, attachment, clock_ports);
   }
   ~FakeNode() override { Leave(); }
 
@@ -179,6 +179,23 @@ TEST_F(Conductor, HoldUntilJoinedStartsTimeWhenTheLastNodeJoins) {
   ASSERT_EQ(a.grants.size(), 1u);
   ASSERT_EQ(b.grants.size(), 1u);
   EXPECT_EQ(a.grants[0], b.grants[0]);
+}
+
+// A process with two ports has joined once both have: it powers on when its last port connects,
+// and time started by its first port alone ran on without it (to the fleet's ready timeout, as fast
+// as the broker goes, when its other port's Hello was late).
+TEST_F(Conductor, HoldUntilJoinedWaitsForEveryPortOfAProcess) {
+  broker.AddBus({.name = "can1", .bitrate = kBitrate});
+  conductor.HoldUntilJoined(1, std::chrono::milliseconds(60'000));
+  FakeNode dl0("dl-can0", conductor, broker, "dl#2", "can0", 7, 2);
+  Poll();
+  EXPECT_TRUE(dl0.grants.empty()) << "its port on can1 has not joined yet";
+  FakeNode dl1("dl-can1", conductor, broker, "dl#2", "can1", 8, 2);
+  Poll();
+  ASSERT_EQ(dl0.grants.size(), 1u);
+  ASSERT_EQ(dl1.grants.size(), 1u);
+  EXPECT_EQ(dl0.grants[0], std::make_pair(std::int64_t{0}, L));
+  EXPECT_EQ(dl1.grants[0], dl0.grants[0]);
 }
 
 // An outside input (a control request) arriving while a round is open waits for its end.
