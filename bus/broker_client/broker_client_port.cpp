@@ -10,6 +10,7 @@
 #include <asio/post.hpp>
 #include <asio/steady_timer.hpp>
 #include <asio/write.hpp>
+#include <span>
 #include <stdexcept>
 
 #include "bus/physics/wire_model.hpp"
@@ -56,7 +57,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   }
 
   void Shutdown() {
-    if (phase_ == Phase::kConnected && options_.virtual_time)
+    if ((phase_ == Phase::kConnected || phase_ == Phase::kHandshake) && options_.virtual_time)
       options_.virtual_time->Disconnected(options_.virtual_time_index);
     owner_ = nullptr;
     phase_ = Phase::kStopped;
@@ -165,6 +166,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
       hello.set_virtual_time(true);
       hello.set_clock_id(options_.virtual_time->clock_id());
       hello.set_clock_ports(static_cast<std::uint32_t>(options_.virtual_time->port_count()));
+      // From here the broker may join this connection and name it in a grant another port reads
+      // first: the process's other ports wait for it (VirtualTimeClient::RunIfAllGranted).
+      hello.set_clock_attachment(options_.virtual_time->Attaching(options_.virtual_time_index));
     }
     filling_.AddHello(hello);
     const std::uint64_t gen = generation_;
@@ -275,15 +279,17 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
       case wire::MessageType::kNodeRequest:
         OnNodeRequest(m.envelope.node_request());
         return;
-      case wire::MessageType::kTimeGrant:
+      case wire::MessageType::kTimeGrant: {
         if (!options_.virtual_time) {
           ProtocolError("TimeGrant on a connection in real time");
           return;
         }
-        options_.virtual_time->Granted(options_.virtual_time_index,
-                                       TimePoint(Duration(m.envelope.time_grant().now_ns())),
-                                       TimePoint(Duration(m.envelope.time_grant().until_ns())));
+        const wire::TimeGrant& grant = m.envelope.time_grant();
+        options_.virtual_time->Granted(options_.virtual_time_index, TimePoint(Duration(grant.now_ns())),
+                                       TimePoint(Duration(grant.until_ns())),
+                                       std::span(grant.attachments().data(), grant.attachments().size()));
         return;
+      }
       case wire::MessageType::kHello:
       case wire::MessageType::kHelloReply:
       case wire::MessageType::kNodeReply:
@@ -499,7 +505,8 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   void Fail(const std::string& reason) {
     if (phase_ == Phase::kStopped) return;
     const bool was_connected = phase_ == Phase::kConnected;
-    if (was_connected && options_.virtual_time)
+    // An attempt that sent its Hello may be named by a grant another port holds: no longer wait.
+    if ((was_connected || phase_ == Phase::kHandshake) && options_.virtual_time)
       options_.virtual_time->Disconnected(options_.virtual_time_index);
     ++generation_;
     CloseSocket();

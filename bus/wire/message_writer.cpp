@@ -133,11 +133,13 @@ void MessageWriter::AddBitRate(std::uint32_t bitrate) {
   AppendProto([&](Envelope& e) { e.mutable_bit_rate()->set_bitrate(bitrate); });
 }
 
-void MessageWriter::AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns) {
+void MessageWriter::AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns,
+                                 std::span<const std::uint64_t> attachments) {
   AppendProto([&](Envelope& e) {
     auto* grant = e.mutable_time_grant();
     grant->set_now_ns(now_ns);
     grant->set_until_ns(until_ns);
+    grant->mutable_attachments()->Add(attachments.begin(), attachments.end());
   });
 }
 

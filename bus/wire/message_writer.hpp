@@ -92,8 +92,10 @@ class MessageWriter {
   void AddNodeReply(const NodeReply& reply);
   /// BitRate{bitrate}: the node's controller now runs at `bitrate` bit/s (0: the bus's rate).
   void AddBitRate(std::uint32_t bitrate);
-  /// TimeGrant{now_ns, until_ns} (virtual time, broker -> node).
-  void AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns);
+  /// TimeGrant{now_ns, until_ns, attachments} (virtual time, broker -> node): `attachments` names
+  /// the node process's connections the round grants (TimeGrant.attachments).
+  void AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns,
+                    std::span<const std::uint64_t> attachments = {});
   /// TimeReached{time_ns, next deadline} (virtual time, node -> broker); no deadline: nullopt.
   void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns);
   /// Acceptance{ids} (virtual time, node -> broker); nullopt: every frame.

@@ -342,7 +342,7 @@ void NodeSession::Accept(const wire::Hello& hello) {
   stats_->attached++;
   if (conductor != nullptr && hello.role() != wire::ROLE_MONITOR) {
     granted_ = true;
-    conductor->Join(*this, hello.clock_id());
+    conductor->Join(*this, hello.clock_id(), hello.clock_attachment(), hello.clock_ports());
   }
   spdlog::info("{}: attached ({}{}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
                hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string(),
@@ -517,8 +517,8 @@ void NodeSession::TxConfirmed(std::span<const broker::TimedFrame> frames) {
   Queued();
 }
 
-void NodeSession::SendGrant(TimePoint now, TimePoint until) {
-  filling_.AddTimeGrant(now.time_since_epoch().count(), until.time_since_epoch().count());
+void NodeSession::SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) {
+  filling_.AddTimeGrant(now.time_since_epoch().count(), until.time_since_epoch().count(), attachments);
   ScheduleFlush();
 }
 

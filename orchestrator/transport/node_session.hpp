@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -80,7 +81,7 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   void TxConfirmed(std::span<const broker::TimedFrame> frames) override;
 
   // GrantedSession
-  void SendGrant(TimePoint now, TimePoint until) override;
+  void SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) override;
   void Evict(const std::string& reason) override;
   const std::string& Label() const override { return label_; }
 

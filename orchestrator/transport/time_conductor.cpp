@@ -36,15 +36,20 @@ TimeConductor::~TimeConductor() {
   join_timer_.cancel();
 }
 
-void TimeConductor::Join(GrantedSession& session, const std::string& clock_id) {
+void TimeConductor::Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment,
+                         std::uint32_t clock_ports) {
   Participant& p = participants_[clock_id];
   p.clock_id = clock_id;
   p.sessions.push_back(&session);
+  p.ports = std::max<std::size_t>(clock_ports, 1);
   p.pending = true;  // it may act now (boot-up): it takes part in the next round
-  sessions_[&session] = SessionState{&p, false};
+  sessions_[&session] = SessionState{&p, attachment, false};
   spdlog::debug("virtual time: {} joined at {} ({})", session.Label(), TimeText(Now()), clock_id);
-  if (join_target_ && participants_.size() >= *join_target_) {
-    spdlog::info("virtual time: {} node process(es) joined; time starts at {}", participants_.size(),
+  // A process counts once every port it attaches has joined: it powers on when its last port is
+  // connected, and time started by its first port would run on (to a scenario's timeout, at the
+  // speed of the broker alone) while the others are still on their way.
+  if (join_target_ && JoinedProcesses() >= *join_target_) {
+    spdlog::info("virtual time: {} node process(es) joined; time starts at {}", JoinedProcesses(),
                  TimeText(Now()));
     join_target_.reset();
     join_timer_.cancel();
@@ -124,15 +129,22 @@ void TimeConductor::Release() {
   if (holds_ > 0 && --holds_ == 0) Kick();
 }
 
+std::size_t TimeConductor::JoinedProcesses() const {
+  return static_cast<std::size_t>(std::ranges::count_if(
+      participants_, [](const auto& entry) { return entry.second.sessions.size() >= entry.second.ports; }));
+}
+
 void TimeConductor::HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout) {
-  if (processes == 0 || participants_.size() >= processes) return;
+  if (processes == 0 || JoinedProcesses() >= processes) return;
   Hold();
   join_target_ = processes;
   join_timer_.expires_after(timeout);
   join_timer_.async_wait([this, alive = std::weak_ptr<int>(alive_), timeout](const asio::error_code& ec) {
     if (ec || alive.expired() || !join_target_) return;
-    spdlog::warn("virtual time: {} of {} node processes joined within {} ms (real time); time starts anyway",
-                 participants_.size(), *join_target_, timeout.count());
+    spdlog::warn(
+        "virtual time: {} of {} node processes joined on all their ports within {} ms (real time); time "
+        "starts anyway",
+        JoinedProcesses(), *join_target_, timeout.count());
     join_target_.reset();
     Release();
   });
@@ -235,8 +247,18 @@ bool TimeConductor::OpenRound() {
   });
   stats_.grants += granted.size();
   granting_ = true;
-  for (GrantedSession* s : granted)
-    if (sessions_.contains(s)) s->SendGrant(now, until);
+  for (GrantedSession* s : granted) {
+    auto it = sessions_.find(s);
+    if (it == sessions_.end()) continue;  // left while an earlier grant was sent
+    // Each grant names every session of its process granted with it (all of them): the process
+    // reads its ports in no set order, and may read this grant before the HelloReply of another
+    // port joined before this round (orchestrator/broker/README.md "Virtual time",
+    // VirtualTimeClient::RunIfAllGranted).
+    attachments_.clear();
+    for (const GrantedSession* sibling : it->second.participant->sessions)
+      if (const std::uint64_t a = sessions_.at(sibling).attachment; a != 0) attachments_.push_back(a);
+    s->SendGrant(now, until, attachments_);
+  }
   granting_ = false;
   if (outstanding_ == 0) {
     CloseRound();

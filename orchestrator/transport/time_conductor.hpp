@@ -48,8 +48,10 @@ namespace canfleet::transport {
 class GrantedSession {
  public:
   virtual ~GrantedSession() = default;
-  /// Sends TimeGrant{now, until} after whatever was sent to the node since its last grant.
-  virtual void SendGrant(TimePoint now, TimePoint until) = 0;
+  /// Sends TimeGrant{now, until, attachments} after whatever was sent to the node since its last
+  /// grant. `attachments`: the Hello.clock_attachment of each of the process's sessions this round
+  /// grants (this one's included), by which the process knows which of its ports to wait for.
+  virtual void SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) = 0;
   /// The node did not answer in time: close the connection, saying why.
   virtual void Evict(const std::string& reason) = 0;
   /// For logs: "session 3 [quad-5 on can0, port 7]".
@@ -91,8 +93,11 @@ class TimeConductor {
 
   // --- sessions (NodeSession) ---
   /// A node process's port joins at the current time (call it between rounds: from AtBoundary).
-  /// `clock_id` groups the ports of one process; it is granted on all of them together.
-  void Join(GrantedSession& session, const std::string& clock_id);
+  /// `clock_id` groups the ports of one process; it is granted on all of them together, each grant
+  /// naming them all by their `attachment` (Hello.clock_attachment; 0: not named). `clock_ports`:
+  /// how many ports the process attaches (Hello.clock_ports; 0: not stated, one).
+  void Join(GrantedSession& session, const std::string& clock_id, std::uint64_t attachment = 0,
+            std::uint32_t clock_ports = 1);
   /// The session ends (disconnected, closed, evicted): its process is no longer waited for on it.
   void Leave(GrantedSession& session);
   /// Something was sent to the session's node at the current time: it takes part in the next round.
@@ -110,9 +115,9 @@ class TimeConductor {
   /// Time stands still until as many Release() calls (the fleet holds it until its nodes joined).
   void Hold();
   void Release();
-  /// Holds time until `processes` node processes have joined (a fleet's nodes all start at the
-  /// same simulated time, whatever their real start-up order), or `timeout` of real time has
-  /// passed (then it says how many joined, and time goes on).
+  /// Holds time until `processes` node processes have joined, each on every port it attaches (a
+  /// fleet's nodes all start at the same simulated time, whatever their real start-up order), or
+  /// `timeout` of real time has passed (then it says how many joined, and time goes on).
   void HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout);
 
   TimePoint Now() const { return scheduler_.Now(); }
@@ -125,12 +130,14 @@ class TimeConductor {
   struct Participant {
     std::string clock_id;
     std::vector<GrantedSession*> sessions;
+    std::size_t ports = 1;          ///< how many the process attaches (Hello.clock_ports)
     std::optional<TimePoint> next;  ///< its next deadline, as last reported
     bool pending = false;           ///< something was sent to it at the current time
   };
   struct SessionState {
     Participant* participant = nullptr;
-    bool granted = false;  ///< granted in the open round and not answered yet
+    std::uint64_t attachment = 0;  ///< the process's number for the connection (Hello.clock_attachment)
+    bool granted = false;          ///< granted in the open round and not answered yet
   };
   struct Submission {
     TimePoint time;
@@ -141,6 +148,8 @@ class TimeConductor {
     CanFrame frame;
   };
 
+  /// Node processes joined on every port they attach.
+  std::size_t JoinedProcesses() const;
   void Kick();
   void StartRound();
   /// Opens a round to G; false when nothing is due (idle) or pacing delays it.
@@ -170,6 +179,7 @@ class TimeConductor {
   std::vector<Submission> submissions_;
   std::uint64_t next_sequence_ = 0;
   std::deque<std::function<void()>> boundary_;
+  std::vector<std::uint64_t> attachments_;  ///< the grant being sent names these (reused)
 
   bool round_open_ = false;
   bool advancing_ = false;

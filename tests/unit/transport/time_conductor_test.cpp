@@ -26,19 +26,22 @@ constexpr std::int64_t Ns(Duration d) {
 }
 constexpr std::int64_t L = Ns(TimeConductor::kLookahead);
 
-/// A node process with one port, as its NodeSession would present it to the conductor.
+/// A port of a node process (one port unless `clock` names another's), as its NodeSession would
+/// present it to the conductor.
 class FakeNode final : public GrantedSession, public broker::PortSink {
  public:
-  FakeNode(std::string name, TimeConductor& conductor, broker::Broker& broker)
-      : name_(std::move(name)), conductor_(conductor), broker_(broker) {
-    port = broker_.Attach("can0", name_, *this);
-    conductor_.Join(*this, name_);
+  FakeNode(std::string name, TimeConductor& conductor, broker::Broker& broker, std::string clock = {},
+           std::string bus = "can0", std::uint64_t attachment = 0, std::uint32_t clock_ports = 1)
+      : name_(std::move(name)), bus_(std::move(bus)), conductor_(conductor), broker_(broker) {
+    port = broker_.Attach(bus_, name_, *this);
+    conductor_.Join(*this, clock.empty() ? name_ : clock, attachment, clock_ports);
   }
   ~FakeNode() override { Leave(); }
 
   // GrantedSession
-  void SendGrant(TimePoint now, TimePoint until) override {
+  void SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) override {
     grants.push_back({Ns(now.time_since_epoch()), Ns(until.time_since_epoch())});
+    named.emplace_back(attachments.begin(), attachments.end());
     if (answer_at_once) {
       answer_at_once = false;
       Reach(until.time_since_epoch() + answer_period);
@@ -74,6 +77,7 @@ class FakeNode final : public GrantedSession, public broker::PortSink {
 
   broker::PortId port = 0;
   std::vector<std::pair<std::int64_t, std::int64_t>> grants;  ///< (now, until) in ns
+  std::vector<std::vector<std::uint64_t>> named;              ///< each grant's attachments
   std::vector<std::string> received;
   std::string evicted;
   /// Answers the next grant from inside SendGrant, its next deadline `answer_period` after the grant.
@@ -82,7 +86,7 @@ class FakeNode final : public GrantedSession, public broker::PortSink {
 
  private:
   std::string name_;
-  std::string bus_ = "can0";
+  std::string bus_;
   TimeConductor& conductor_;
   broker::Broker& broker_;
   bool left_ = false;
@@ -177,6 +181,23 @@ TEST_F(Conductor, HoldUntilJoinedStartsTimeWhenTheLastNodeJoins) {
   EXPECT_EQ(a.grants[0], b.grants[0]);
 }
 
+// A process with two ports has joined once both have: it powers on when its last port connects,
+// and time started by its first port alone ran on without it (to the fleet's ready timeout, as fast
+// as the broker goes, when its other port's Hello was late).
+TEST_F(Conductor, HoldUntilJoinedWaitsForEveryPortOfAProcess) {
+  broker.AddBus({.name = "can1", .bitrate = kBitrate});
+  conductor.HoldUntilJoined(1, std::chrono::milliseconds(60'000));
+  FakeNode dl0("dl-can0", conductor, broker, "dl#2", "can0", 7, 2);
+  Poll();
+  EXPECT_TRUE(dl0.grants.empty()) << "its port on can1 has not joined yet";
+  FakeNode dl1("dl-can1", conductor, broker, "dl#2", "can1", 8, 2);
+  Poll();
+  ASSERT_EQ(dl0.grants.size(), 1u);
+  ASSERT_EQ(dl1.grants.size(), 1u);
+  EXPECT_EQ(dl0.grants[0], std::make_pair(std::int64_t{0}, L));
+  EXPECT_EQ(dl1.grants[0], dl0.grants[0]);
+}
+
 // An outside input (a control request) arriving while a round is open waits for its end.
 TEST_F(Conductor, AnOutsideInputWaitsForTheEndOfTheOpenRound) {
   FakeNode a("a", conductor, broker);
@@ -206,6 +227,31 @@ TEST(ConductorGrace, ANodeThatStopsAnsweringIsEvictedAndTimeGoesOn) {
   ASSERT_GE(a.grants.size(), 2u) << "a's next deadline is granted without b";
   EXPECT_EQ(a.grants[1].second, L + Ns(500ms) + L);
   EXPECT_EQ(b.grants.size(), 1u);
+}
+
+// The ports of one process are granted together, and each grant names all of them (their
+// Hello.clock_attachment): the process may read one port's grant before another port's HelloReply,
+// and must then wait for that port rather than run without it. A port that left is no longer named.
+TEST_F(Conductor, EachGrantNamesEveryPortOfItsProcessGrantedWithIt) {
+  broker.AddBus({.name = "can1", .bitrate = kBitrate});
+  FakeNode q("q", conductor, broker, "q#1", "can0", 1);
+  FakeNode dl0("dl-can0", conductor, broker, "dl#2", "can0", 7);
+  FakeNode dl1("dl-can1", conductor, broker, "dl#2", "can1", 8);
+  Poll();
+  ASSERT_EQ(dl0.grants.size(), 1u);
+  ASSERT_EQ(dl1.grants.size(), 1u);
+  EXPECT_EQ(dl0.grants[0], dl1.grants[0]);
+  EXPECT_EQ(dl0.named[0], (std::vector<std::uint64_t>{7, 8}));
+  EXPECT_EQ(dl1.named[0], (std::vector<std::uint64_t>{7, 8}));
+  EXPECT_EQ(q.named[0], (std::vector<std::uint64_t>{1})) << "another process's ports are not named";
+  ASSERT_TRUE(q.Reach(std::nullopt));
+  ASSERT_TRUE(dl0.Reach(100ms));
+  ASSERT_TRUE(dl1.Reach(100ms));
+  dl1.Leave();
+  Poll();
+  ASSERT_EQ(dl0.grants.size(), 2u);
+  EXPECT_EQ(dl0.named[1], (std::vector<std::uint64_t>{7}));
+  EXPECT_EQ(dl1.grants.size(), 1u);
 }
 
 // A reply that is not for the open round's time, or a second one, is refused.

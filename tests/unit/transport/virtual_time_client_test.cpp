@@ -1,6 +1,6 @@
 // A node process's side of lock-step virtual time (bus/broker_client/virtual_time_client.hpp): what
 // the broker sent is applied at the grant's time, timers run to the grant's end, and a process with
-// two ports runs only once both are granted.
+// two ports runs only once every port its grant names is granted.
 #include "bus/broker_client/virtual_time_client.hpp"
 
 #include <gtest/gtest.h>
@@ -62,7 +62,8 @@ TEST(VirtualTimeClient, ATwoPortProcessRunsOnceEveryConnectedPortIsGranted) {
                                            "b reached 24 idle"}));
 }
 
-// A port that disconnects is no longer waited for.
+// A port that disconnects is no longer waited for (a broker that names no connections in its
+// grants: every connected port is).
 TEST(VirtualTimeClient, APortThatDisconnectsIsNoLongerWaitedFor) {
   GrantedScheduler s;
   std::vector<std::string> log;
@@ -73,6 +74,83 @@ TEST(VirtualTimeClient, APortThatDisconnectsIsNoLongerWaitedFor) {
   client.Granted(0, TimePoint(0ns), TimePoint(24ns));
   client.Disconnected(1);
   EXPECT_EQ(log, (std::vector<std::string>{"a apply at 0", "a reached 24 idle"}));
+}
+
+// The race of a process with two ports (the data logger on can0 and can1): the broker joined both
+// before the round and granted both, each grant naming both connections; the node read port 1's
+// HelloReply and grant before port 0's HelloReply. It waits for port 0 instead of running without
+// it (which left port 0's grant unanswered: the broker closed it after 10 s of real time).
+TEST(VirtualTimeClient, AGrantReadBeforeAnotherPortsHelloReplyWaitsForThatPortsGrant) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  VirtualTimeClient client(s, "datalogger#5", 2);
+  FakePort a("a", log, s), b("b", log, s);
+  const std::uint64_t a_id = client.Attaching(0);
+  const std::uint64_t b_id = client.Attaching(1);
+  ASSERT_NE(a_id, b_id);
+  const std::vector<std::uint64_t> both{a_id, b_id};
+  client.Connected(1, b, TimePoint(0ns));
+  client.Granted(1, TimePoint(0ns), TimePoint(24ns), both);
+  EXPECT_TRUE(log.empty()) << "port 0 is named by the grant: its HelloReply and grant are on their way";
+  EXPECT_EQ(client.Rounds(), 0u);
+  client.Connected(0, a, TimePoint(0ns));
+  EXPECT_TRUE(log.empty());
+  client.Granted(0, TimePoint(0ns), TimePoint(24ns), both);
+  EXPECT_EQ(log, (std::vector<std::string>{"a apply at 0", "b apply at 0", "a reached 24 idle",
+                                           "b reached 24 idle"}));
+  EXPECT_EQ(client.Rounds(), 1u);
+}
+
+// A port whose Hello the broker had not accepted before the round is not granted in it, and not
+// waited for: the broker accepts it only once this round is answered.
+TEST(VirtualTimeClient, APortStillAttachingThatTheGrantDoesNotNameIsNotWaitedFor) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  VirtualTimeClient client(s, "datalogger#6", 2);
+  FakePort a("a", log, s), b("b", log, s);
+  const std::uint64_t a_id = client.Attaching(0);
+  client.Attaching(1);
+  client.Connected(0, a, TimePoint(0ns));
+  client.Granted(0, TimePoint(0ns), TimePoint(24ns), std::vector<std::uint64_t>{a_id});
+  EXPECT_EQ(log, (std::vector<std::string>{"a apply at 0", "a reached 24 idle"}));
+}
+
+// A named port whose attempt fails, or that lost the connection the grant named and is attaching
+// again, is no longer waited for: the broker no longer waits for it either.
+TEST(VirtualTimeClient, ANamedPortWhoseConnectionIsGoneIsNoLongerWaitedFor) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  VirtualTimeClient client(s, "datalogger#7", 2);
+  FakePort a("a", log, s), b("b", log, s);
+  const std::uint64_t a_id = client.Attaching(0);
+  const std::uint64_t b_id = client.Attaching(1);
+  client.Connected(1, b, TimePoint(0ns));
+  client.Granted(1, TimePoint(0ns), TimePoint(24ns), std::vector<std::uint64_t>{a_id, b_id});
+  EXPECT_TRUE(log.empty());
+  client.Disconnected(0);  // port 0's attempt failed before its HelloReply
+  EXPECT_EQ(log, (std::vector<std::string>{"b apply at 0", "b reached 24 idle"}));
+
+  log.clear();
+  const std::uint64_t a_again = client.Attaching(0);
+  EXPECT_NE(a_again, a_id) << "a new attempt is a new connection";
+  client.Granted(1, TimePoint(24ns), TimePoint(48ns), std::vector<std::uint64_t>{a_id, b_id});
+  EXPECT_EQ(log, (std::vector<std::string>{"b apply at 24", "b reached 48 idle"}))
+      << "the grant names port 0's lost connection, not the new attempt";
+}
+
+// A connected port the grant does not name (the broker closed it; the node has not read that yet)
+// is neither waited for nor answered.
+TEST(VirtualTimeClient, AConnectedPortTheGrantDoesNotNameIsNotPartOfTheRound) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  VirtualTimeClient client(s, "datalogger#8", 2);
+  FakePort a("a", log, s), b("b", log, s);
+  client.Attaching(0);
+  const std::uint64_t b_id = client.Attaching(1);
+  client.Connected(0, a, TimePoint(0ns));
+  client.Connected(1, b, TimePoint(0ns));
+  client.Granted(1, TimePoint(0ns), TimePoint(24ns), std::vector<std::uint64_t>{b_id});
+  EXPECT_EQ(log, (std::vector<std::string>{"b apply at 0", "b reached 24 idle"}));
 }
 
 // A node joining a running bus starts at the bus's time.

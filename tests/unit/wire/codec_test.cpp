@@ -62,6 +62,7 @@ Bytes MixedStream() {
   w.AddFrame(Frame("182#BB"), BusTime(7000));
   w.AddBitRate(250'000);
   w.AddTimeGrant(7000, 7024);
+  w.AddTimeGrant(7024, 7048, std::vector<std::uint64_t>{3, 4});
   w.AddTimeReached(7024, 500'000'000);
   w.AddTimeReached(7024, std::nullopt);
   w.AddAcceptance(std::vector<std::uint32_t>{0x000, 0x605, 0x7E5});
@@ -85,6 +86,7 @@ const std::vector<std::string> kMixedExpected = {
     "FrameBatch 182#BB@7000",
     "BitRate 250000",
     "TimeGrant 7000..7024",
+    "TimeGrant 7024..7048 #3 #4",
     "TimeReached 7024 next 500000000",
     "TimeReached 7024 idle",
     "Acceptance 3 ids",

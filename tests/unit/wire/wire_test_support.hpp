@@ -66,6 +66,8 @@ inline std::string Describe(const Message& m) {
     case MessageType::kTimeGrant:
       out += " " + std::to_string(m.envelope.time_grant().now_ns()) + ".." +
              std::to_string(m.envelope.time_grant().until_ns());
+      for (const std::uint64_t a : m.envelope.time_grant().attachments())
+        out += " #" + std::to_string(a);
       break;
     case MessageType::kAcceptance:
       out += m.envelope.acceptance().all()
