@@ -256,7 +256,7 @@ TEST_F(DataLoggerFleetTest, BusOffIsReportedAfterRecoveryByThatPortOnly) {
   EXPECT_TRUE(WaitLog(LoggerEmcy(0x8140, 0x01, "00 00 00 00 00", kCan2))) << fleet().Log();
   EXPECT_EQ(SdoOn(kCan2, "0x1003", 0, "u8"), 0u);  // error-free again: sub-index 0 is zero
   EXPECT_EQ(SdoOn(kCan2, "0x1001", 0, "u8"), 0u);
-  EXPECT_EQ(PortNmt(kCan2), "operational");        // 1029h.1 = 1
+  EXPECT_EQ(PortNmt(kCan2), "operational");  // 1029h.1 = 1
   EXPECT_EQ(SdoOn(kCan1, "0x1003", 0, "u8"), 0u);
   EXPECT_EQ(PortNmt(kCan1), "operational");
 
