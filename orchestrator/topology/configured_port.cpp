@@ -27,12 +27,12 @@ bool ConfiguredPort::Has(std::uint16_t index, std::uint8_t sub) const {
   return od_->Find(index, sub) != nullptr;
 }
 
-std::uint64_t ConfiguredPort::Unsigned(std::uint16_t index, std::uint8_t sub) const {
+std::uint32_t ConfiguredPort::Unsigned(std::uint16_t index, std::uint8_t sub) const {
   if (const auto it = written_.find({index, sub}); it != written_.end())
-    return canopen::DecodeUnsignedLe(it->second.first);
+    return static_cast<std::uint32_t>(canopen::DecodeUnsignedLe(it->second.first));
   const canopen::SubObject* object = od_->Find(index, sub);
   if (object == nullptr) return 0;
-  return canopen::DecodeUnsignedLe(object->DefaultFor(node_id_));
+  return static_cast<std::uint32_t>(canopen::DecodeUnsignedLe(object->DefaultFor(node_id_)));
 }
 
 ValueOrigin ConfiguredPort::Origin(std::uint16_t index, std::uint8_t sub) const {

@@ -44,8 +44,9 @@ class ConfiguredPort {
   void Apply(const PlannedWrite& write);
 
   bool Has(std::uint16_t index, std::uint8_t sub) const;
-  /// The value as an unsigned integer (little-endian, at most 8 bytes); 0 when absent.
-  std::uint64_t Unsigned(std::uint16_t index, std::uint8_t sub) const;
+  /// The value as an unsigned integer (little-endian, its low 32 bits: no communication object
+  /// read here is wider); 0 when absent.
+  std::uint32_t Unsigned(std::uint16_t index, std::uint8_t sub) const;
   ValueOrigin Origin(std::uint16_t index, std::uint8_t sub) const;
   /// Where the value comes from, for messages: "its default", "heartbeat.producer_ms", "sdo[2]",
   /// "its DCF".

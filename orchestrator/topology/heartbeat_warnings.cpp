@@ -42,10 +42,10 @@ std::vector<TopologyWarning> HeartbeatWarnings(const Scope& root, const std::vec
     for (std::uint8_t sub = 1; sub <= kMaxConsumers && port.Has(kConsumerIndex, sub); ++sub) {
       const ValueOrigin origin = port.Origin(kConsumerIndex, sub);
       if (origin.is_default) continue;  // the device's own entries are its business
-      const std::uint64_t entry = port.Unsigned(kConsumerIndex, sub);
+      const std::uint32_t entry = port.Unsigned(kConsumerIndex, sub);
       // CiA 301 §7.5.2.28: bits 23..16 node-ID, bits 15..0 the consumer time in ms; 0 = unused.
-      const auto node_id = static_cast<std::uint32_t>((entry >> 16) & 0xFF);
-      const auto time_ms = static_cast<std::uint32_t>(entry & 0xFFFF);
+      const std::uint32_t node_id = (entry >> 16) & 0xFF;
+      const std::uint32_t time_ms = entry & 0xFFFF;
       if (node_id == 0 || node_id > 127 || time_ms == 0) continue;
       const Key key{port.node().index, static_cast<int>(origin.source.field), origin.source.index};
       const ConfiguredPort* producer = ProducerOn(ports, port, node_id);
@@ -55,7 +55,7 @@ std::vector<TopologyWarning> HeartbeatWarnings(const Scope& root, const std::vec
         continue;
       }
       found[key] = true;
-      const std::uint64_t period_ms = producer->Unsigned(kProducerIndex, 0);
+      const std::uint32_t period_ms = producer->Unsigned(kProducerIndex, 0);
       const std::string who = port.Name() + " consumes the heartbeat of " + producer->Name() + " (node-ID " +
                               std::to_string(node_id) + " on " + port.bus() + ")";
       if (period_ms == 0) {

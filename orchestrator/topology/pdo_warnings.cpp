@@ -72,7 +72,7 @@ void CheckRpdos(const Scope& root, const ConfiguredPort& port, const BusTraffic&
   for (std::size_t n = 0; n < canopen::kMaxPdos; ++n) {
     const auto comm = static_cast<std::uint16_t>(canopen::kRpdoCommBase + n);
     if (!port.Has(comm, kCobIdSub)) continue;
-    const auto id = canopen::PdoCobId::Decode(static_cast<std::uint32_t>(port.Unsigned(comm, kCobIdSub)));
+    const auto id = canopen::PdoCobId::Decode(port.Unsigned(comm, kCobIdSub));
     const auto type = port.Has(comm, kTypeSub) ? static_cast<std::uint8_t>(port.Unsigned(comm, kTypeSub))
                                                : canopen::kTransmissionEventProfile;
     if (!id.valid || !canopen::IsUsableType(canopen::PdoDirection::kReceive, type)) continue;

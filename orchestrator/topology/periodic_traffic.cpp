@@ -33,7 +33,7 @@ std::vector<Tpdo> ValidTpdos(const ConfiguredPort& port) {
     Tpdo tpdo;
     tpdo.port = &port;
     tpdo.number = static_cast<int>(n + 1);
-    tpdo.cob_id = canopen::PdoCobId::Decode(static_cast<std::uint32_t>(port.Unsigned(comm, kCobIdSub)));
+    tpdo.cob_id = canopen::PdoCobId::Decode(port.Unsigned(comm, kCobIdSub));
     tpdo.type = Type(port, comm);
     tpdo.bytes = MappedBytes(port, static_cast<std::uint16_t>(comm + canopen::kMappingOffset));
     if (!tpdo.cob_id.valid || !canopen::IsUsableType(canopen::PdoDirection::kTransmit, tpdo.type) ||
@@ -41,7 +41,7 @@ std::vector<Tpdo> ValidTpdos(const ConfiguredPort& port) {
       continue;
     if (canopen::IsEventDriven(tpdo.type)) {
       const milliseconds timer(port.Unsigned(comm, kEventTimerSub));
-      const microseconds inhibit(100 * port.Unsigned(comm, kInhibitSub));
+      const microseconds inhibit(100ULL * port.Unsigned(comm, kInhibitSub));
       if (timer.count() > 0) tpdo.period = std::max<microseconds>(timer, inhibit);
     }
     out.push_back(tpdo);
@@ -73,7 +73,7 @@ std::uint8_t MappedBytes(const ConfiguredPort& port, std::uint16_t mapping_index
   const auto entries = static_cast<std::uint8_t>(port.Unsigned(mapping_index, 0));
   std::uint32_t bits = 0;
   for (std::uint8_t sub = 1; sub <= entries && sub <= canopen::kMaxMappingEntries; ++sub)
-    bits += static_cast<std::uint32_t>(port.Unsigned(mapping_index, sub) & 0xFF);
+    bits += port.Unsigned(mapping_index, sub) & 0xFF;
   return static_cast<std::uint8_t>(std::min<std::uint32_t>((bits + 7) / 8, kMaxPdoBytes));
 }
 
