@@ -5,7 +5,7 @@
 #include <asio/post.hpp>
 
 #include "orchestrator/capture/capture_tap.hpp"
-#include "orchestrator/fleet/configuration_plan.hpp"
+#include "orchestrator/topology/configuration_plan.hpp"
 
 namespace canfleet::fleet {
 
@@ -211,12 +211,12 @@ void Fleet::Configure(const FleetNode& node, std::size_t port) {
   auto& runtime = runtime_[{node.name(), port}];
   runtime.configured = false;
   runtime.configuration = "configuring";
-  std::vector<PlannedWrite> plan;
+  std::vector<topology::PlannedWrite> plan;
   auto failures = std::make_shared<std::vector<std::string>>();
   try {
-    plan = PlanConfiguration(node, port, [this](const std::string& other, const std::string& on_bus) {
-      return NodeIdOn(other, on_bus);
-    });
+    plan = topology::PlanConfiguration(
+        node.spec, node.buses, node.node_ids, port,
+        [this](const std::string& other, const std::string& on_bus) { return NodeIdOn(other, on_bus); });
   } catch (const std::exception& e) {
     failures->push_back(std::string("configuration refused: ") + e.what());
     spdlog::error("{}: {}", node.name(), failures->back());
@@ -224,18 +224,18 @@ void Fleet::Configure(const FleetNode& node, std::size_t port) {
   const std::string bus = node.buses[port];
   const std::uint8_t id = node.node_ids[port];
   const std::string name = node.name();
-  auto steps = std::make_shared<std::vector<PlannedWrite>>(std::move(plan));
+  auto steps = std::make_shared<std::vector<topology::PlannedWrite>>(std::move(plan));
   // Each SDO completion owns the continuation (a strong reference); the continuation itself only
   // holds a weak one, so the chain frees itself after the last step.
   auto next = std::make_shared<std::function<void(std::size_t)>>();
   std::weak_ptr<std::function<void(std::size_t)>> weak_next = next;
   *next = [this, steps, failures, weak_next, bus, id, name, port](std::size_t i) {
     if (i < steps->size()) {
-      const PlannedWrite& write = (*steps)[i];
+      const topology::PlannedWrite& write = (*steps)[i];
       auto self = weak_next.lock();
       sdo_.at(bus)->Write(id, write.index, write.subindex, write.data, false,
                           [steps, failures, self, i, name](canopen::SdoAbort abort) {
-                            const PlannedWrite& done = (*steps)[i];
+                            const topology::PlannedWrite& done = (*steps)[i];
                             if (abort != canopen::SdoAbort::kNone) {
                               failures->push_back(done.what + ": " + DescribeAbort(abort));
                               spdlog::error("{}: configuring {} failed: {}", name, done.what,

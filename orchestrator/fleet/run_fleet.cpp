@@ -80,6 +80,11 @@ int RunFleet(const UpOptions& options) {
   }
 
   spdlog::set_level(spdlog::level::from_str(options.log_level));
+  // What the loader found that cannot work (topology_warnings.hpp), and each bus's periodic load.
+  for (const auto& warning : loaded.warnings)
+    spdlog::warn("{}", warning.Message());
+  for (const auto& load : loaded.loads)
+    spdlog::info("bus {}: periodic traffic offers {}", load.bus, load.Describe());
   asio::io_context io(1);
   socketcand::ServerOptions socketcand_options;
   socketcand_options.bind_address = options.socketcand_bind;

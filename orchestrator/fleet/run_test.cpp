@@ -92,6 +92,14 @@ class FileRun {
     logger->flush_on(spdlog::level::info);
     auto previous = spdlog::default_logger();
     spdlog::set_default_logger(logger);
+    // What the loader found that cannot work (topology_warnings.hpp): on the report, before the
+    // expectations it may explain, and in the log.
+    for (const auto& warning : loaded.warnings) {
+      out_ << "warn  " << warning.Message() << std::endl;
+      spdlog::warn("{}", warning.Message());
+    }
+    for (const auto& load : loaded.loads)
+      spdlog::info("bus {}: periodic traffic offers {}", load.bus, load.Describe());
     Drive(loaded);
     spdlog::set_default_logger(previous);
     return report_;

@@ -85,6 +85,16 @@ void Scope::FailHere(std::string reason) const {
   throw TopologyError(*file_, loc_.line, loc_.column, path_.empty() ? "topology" : path_, std::move(reason));
 }
 
+TopologyWarning Scope::Warn(std::string_view field, int index, std::string reason) const {
+  const Loc l = At(field, index);
+  return TopologyWarning{*file_, l.line, l.column, PathOf(field, index), std::move(reason)};
+}
+
+TopologyWarning Scope::WarnHere(std::string reason) const {
+  return TopologyWarning{*file_, loc_.line, loc_.column, path_.empty() ? "topology" : path_,
+                         std::move(reason)};
+}
+
 const pb::FieldDescriptor* Scope::Field(std::string_view name) const {
   const pb::FieldDescriptor* fd = message_->GetDescriptor()->FindFieldByName(std::string(name));
   if (fd == nullptr) throw std::logic_error("topology loader: no field " + std::string(name));

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "orchestrator/topology/topology_warning.hpp"
+
 namespace canfleet::topology::detail {
 
 namespace pb = google::protobuf;
@@ -65,6 +67,14 @@ class Scope {
   }
   /// An error about the message as a whole (a missing field is named by the caller's reason).
   [[noreturn]] void FailHere(std::string reason) const;
+
+  /// A warning located as Fail() locates an error: the index-th value of `field`.
+  TopologyWarning Warn(std::string_view field, int index, std::string reason) const;
+  TopologyWarning Warn(std::string_view field, std::string reason) const {
+    return Warn(field, -1, std::move(reason));
+  }
+  /// A warning about the message as a whole.
+  TopologyWarning WarnHere(std::string reason) const;
 
  private:
   const pb::FieldDescriptor* Field(std::string_view name) const;

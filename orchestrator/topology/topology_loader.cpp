@@ -19,10 +19,12 @@
 #include "orchestrator/topology/node_checks.hpp"
 #include "orchestrator/topology/scenario_checks.hpp"
 #include "orchestrator/topology/topology_facts.hpp"
+#include "orchestrator/topology/topology_warnings.hpp"
 
 // The loader runs the checks in order, each job in its own file: located_error (where a refusal
 // points), node_checks (nodes and heartbeats), scenario_checks (the scenario); this file parses,
-// checks the topology's own fields, the orchestrator and the buses, and applies the defaults.
+// checks the topology's own fields, the orchestrator and the buses, and applies the defaults; last,
+// topology_warnings says what would load but cannot work, and each bus's offered load.
 
 namespace canfleet::topology {
 
@@ -58,10 +60,12 @@ class Loader {
     nodes.CheckHeartbeats(root);
     ScenarioChecks(facts_).CheckScenario(root);
     ApplyDefaults();
+    Feasibility feasibility = CheckFeasibility(root, facts_);
     std::vector<int> step_lines;
     for (int i = 0; i < spec_.scenario_size(); ++i)
       step_lines.push_back(root.Child("scenario", spec_.scenario(i), i).loc().line);
-    return LoadedTopology{std::move(spec_), file_, std::move(step_lines)};
+    return LoadedTopology{std::move(spec_), file_, std::move(step_lines), std::move(feasibility.warnings),
+                          std::move(feasibility.loads)};
   }
 
  private:

@@ -18,6 +18,11 @@
 ///   per bus; node.restart.backoff_ms 500; node.log_level "info"; heartbeat consumers given by
 ///   node name get that node's node-ID on the first bus both share.
 /// Every path in `spec` (state_root, state_dir, eds, dcf) is absolute and lexically normal.
+///
+/// A topology that loads may still not work as written: `warnings` says where and why (a
+/// heartbeat consumed from a node that sends none, an RPDO deadline nothing feeds, a bus its
+/// periodic traffic overfills; topologies/README.md "What loading warns about"), and `loads` gives
+/// each bus's offered periodic load.
 
 #include <filesystem>
 #include <stdexcept>
@@ -26,6 +31,7 @@
 #include <vector>
 
 #include "orchestrator/topology/canfleet_topology.pb.h"
+#include "orchestrator/topology/topology_warning.hpp"
 
 namespace canfleet::topology {
 
@@ -56,6 +62,10 @@ struct LoadedTopology {
   Topology spec;
   std::filesystem::path file;
   std::vector<int> step_lines;  ///< the line of each scenario step (1-based), for reports
+  /// Configurations that load but cannot work (topology_warnings.hpp), in a stable order.
+  std::vector<TopologyWarning> warnings;
+  /// The periodic load each bus is offered (bus_load.hpp), one per bus in file order.
+  std::vector<BusLoad> loads;
 };
 
 /// Reads, parses, validates and completes a topology file. Relative paths inside it are relative

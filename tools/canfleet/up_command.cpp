@@ -57,6 +57,9 @@ std::string Plural(int n, const char* one, const char* many) {
 int RunCheck(const std::string& file) {
   try {
     const topology::LoadedTopology loaded = topology::LoadTopology(file);
+    // Warnings do not refuse the file (exit 0): it loads, but what they name cannot work.
+    for (const auto& warning : loaded.warnings)
+      std::cerr << warning.Message() << '\n';
     int expectations = 0;
     for (const auto& step : loaded.spec.scenario())
       expectations += step.has_expect() ? 1 : 0;
@@ -65,6 +68,11 @@ int RunCheck(const std::string& file) {
     if (loaded.spec.scenario_size() > 0)
       std::cout << ", " << Plural(loaded.spec.scenario_size() - expectations, "action", "actions") << ", "
                 << Plural(expectations, "expectation", "expectations");
+    std::cout << "; offered load";
+    for (std::size_t i = 0; i < loaded.loads.size(); ++i)
+      std::cout << (i ? ", " : " ") << loaded.loads[i].bus << " " << loaded.loads[i].Describe();
+    if (!loaded.warnings.empty())
+      std::cout << "; " << Plural(static_cast<int>(loaded.warnings.size()), "warning", "warnings");
     std::cout << '\n';
     return kExitOk;
   } catch (const topology::TopologyError& e) {
@@ -118,8 +126,8 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
   });
 
   auto file = std::make_shared<std::string>();
-  CLI::App* check =
-      app.add_subcommand("check", "Load and validate a topology file without starting anything");
+  CLI::App* check = app.add_subcommand(
+      "check", "Load and validate a topology file without starting anything; warn about what cannot work");
   check->add_option("FILE", *file, "Topology file")->required();
   check->callback([&cli, file] { cli.action = [file] { return RunCheck(*file); }; });
 }

@@ -127,13 +127,13 @@ void Emcy::Raise(const ErrorEntry& error) {
   Emit(error.code, error.msef);
 }
 
-void Emcy::Clear(std::uint16_t code, std::uint16_t info, bool keep_in_history) {
+void Emcy::Clear(std::uint16_t code, std::uint16_t info) {
   auto it = std::find_if(active_.begin(), active_.end(),
                          [&](const ErrorEntry& e) { return e.code == code && e.info == info; });
   if (it == active_.end()) return;
   const std::uint32_t value = it->HistoryValue();
   active_.erase(it);
-  if (options_.remove_cleared_from_history && !keep_in_history) RemoveFromHistory(value);
+  if (options_.remove_cleared_from_history) RemoveFromHistory(value);
   RecomputeRegister();
   SyncRegister();
   SyncHistory();

@@ -95,10 +95,10 @@ class Emcy {
   /// Ends the active error (code, info): its 1003h entry is removed (remove_cleared_from_history),
   /// 1001h is recomputed, and an error-reset EMCY goes out (CiA 301 §7.2.7.1): code 0000h, the new
   /// 1001h, manufacturer bytes zero. With other errors still active it is sent only when
-  /// reset_emcy_on_partial_clear. Nothing happens when (code, info) is not active.
-  /// `keep_in_history`: the 1003h entry stays whatever the option says — for errors that name an
-  /// event rather than a condition (8140h "recovered from bus-off" ends the moment it is sent).
-  void Clear(std::uint16_t code, std::uint16_t info, bool keep_in_history = false);
+  /// reset_emcy_on_partial_clear. Nothing happens when (code, info) is not active. Bus-off is no
+  /// exception: its 8140h entry leaves 1003h at the error reset sent after the recovery (the five
+  /// manuals' 1003h: "immediately removed when the error condition has been cleared").
+  void Clear(std::uint16_t code, std::uint16_t info);
 
   /// Forgets every active error and the history, drops waiting frames and the inhibit state, and
   /// sets 1001h to 0, without sending anything: the reset-node path (the node boots again).

@@ -258,9 +258,9 @@ void CanopenStack::OnCommError(const CommError& error, bool active) {
         if (reaction == 2 && nmt_.State() != NmtState::kStopped) nmt_.SetState(NmtState::kStopped);
       }
     } else {
-      // 8140h means "recovered from bus-off": an event, so its 1003h entry is history the master
-      // reads after the recovery (it could not read anything during bus-off).
-      emcy_.Clear(encoding->entry.code, encoding->entry.info, error.kind == CommErrorKind::kBusOff);
+      // Bus-off included: the 8140h EMCY left first (OnBusOffEnded), then this error reset takes
+      // its entry out of 1003h, as every manual's 1003h asks (e.g. AX020506 §3.1.4).
+      emcy_.Clear(encoding->entry.code, encoding->entry.info);
     }
   }
   if (hooks_.on_comm_error) hooks_.on_comm_error(error, active);

@@ -750,7 +750,9 @@ TEST_F(CanfleetCli, CheckLoadsATopologyWithoutAnOrchestrator) {
                          "node { name: \"quad-6\" device: \"quad-controller\" node_id: 6 bus: \"can0\" }\n";
   Outcome run = Canfleet({"check", good});
   EXPECT_EQ(run.exit, 0) << run.err;
-  EXPECT_EQ(run.out, "ok: 1 bus, 2 nodes\n");
+  // Two Quads' four TPDOs every 100 ms (AX020506 §3.1.1), 440 bits at most, on 500 kbit/s.
+  EXPECT_EQ(run.out, "ok: 1 bus, 2 nodes; offered load can0 1.8 % of 500 kbit/s (TPDOs 1.8 %)\n");
+  EXPECT_EQ(run.err, "");
 
   const std::string bad = dir_.File("bad.textproto");
   std::ofstream(bad) << "name: \"t\"\n"
@@ -760,6 +762,43 @@ TEST_F(CanfleetCli, CheckLoadsATopologyWithoutAnOrchestrator) {
   EXPECT_EQ(run.exit, 2);
   EXPECT_EQ(run.err.substr(0, bad.size() + 3), bad + ":3:") << run.err;
   EXPECT_NE(run.err.find("can9"), std::string::npos) << run.err;
+  EXPECT_TRUE(handler_.Requests().empty());
+}
+
+// A topology that loads but cannot work: one line per warning on stderr, located like an error,
+// the load per bus and the count on the summary line, exit 0 (topologies/README.md "What loading
+// warns about").
+TEST_F(CanfleetCli, CheckWarnsAboutWhatCannotWorkAndStillSucceeds) {
+  const std::string file = dir_.File("warn.textproto");
+  std::ofstream out(file);
+  out << "name: \"t\"\n"
+         "bus { name: \"can0\" bitrate: 125000 }\n"
+         "node { name: \"quad-6\" device: \"quad-controller\" node_id: 6 bus: \"can0\"\n"
+         "  heartbeat { consumer { node: \"quad-1\" timeout_ms: 1000 } } }\n";
+  // 40 operational Quads at 125 kbit/s: 40 × 4400 bit/s of TPDOs = 141 %.
+  for (int id = 1; id <= 40; ++id) {
+    if (id == 6) continue;
+    out << "node { name: \"quad-" << id << "\" device: \"quad-controller\" node_id: " << id
+        << " bus: \"can0\" }\n";
+  }
+  out.close();
+  const Outcome run = Canfleet({"check", file});
+  EXPECT_EQ(run.exit, 0) << run.err;
+  EXPECT_EQ(run.out,
+            "ok: 1 bus, 40 nodes; offered load can0 141 % of 125 kbit/s (TPDOs 141 %); 2 warnings\n");
+  EXPECT_EQ(
+      run.err.substr(0, run.err.find('\n') + 1),
+      file +
+          ":4:15: warning: node[0].heartbeat.consumer[0]: quad-6 consumes the heartbeat of quad-1 (node-ID 1 "
+          "on can0), which sends none: its 1017h is 0 (its default; set its heartbeat.producer_ms). "
+          "Monitoring "
+          "starts with the first heartbeat (CiA 301 §7.2.8.3.2.2), so no loss is ever reported\n");
+  EXPECT_NE(run.err.find(
+                file + ":2:20: warning: bus[0].bitrate: bus can0: periodic traffic offers 141 % of "
+                       "125 kbit/s (TPDOs 141 %): configuration SDOs and low-priority frames will starve\n"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 2);
   EXPECT_TRUE(handler_.Requests().empty());
 }
 

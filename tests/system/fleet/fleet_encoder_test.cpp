@@ -6,7 +6,7 @@
 // Manual references (../shared/seeds/encoder-dual-valve_AX023241.txt; the README's "EMCY codes"
 // table: this manual lists none, the family's are used):
 // - heartbeat of node nn lost: EMCY 8130h, 1003h 80nn8130h (C3-1.2.4); RPDO timeout 8100h,
-//   00008100h; bus-off 8140h, 00008140h kept as the record of the event; 1001h bit 0 only
+//   00008100h; bus-off 8140h, 00008140h removed at the error reset; 1001h bit 0 only
 //   (C3-1.2.2); EMCY data bytes channel, description (family_error_policy.hpp).
 // - C3-1.2.11 1029h sub 1 "Communication Error", default 1 = no state change (encoder-a);
 //   encoder-b is configured to 0 = pre-operational through the topology's SDO list.
@@ -108,7 +108,7 @@ TEST_F(FleetEncoderTest, RpdoTimeoutRaises00008100hAndShutsTheControlledOutputOf
   EXPECT_TRUE(WaitIo("encoder-b", kOut1, 1000)) << IoText("encoder-b", kOut1);
 }
 
-TEST_F(FleetEncoderTest, BusOffSends8140hAfterRecoveryAndKeepsItIn1003h) {
+TEST_F(FleetEncoderTest, BusOffSends8140hAfterRecoveryAndTheResetEmpties1003h) {
   for (const char* encoder : {"encoder-a", "encoder-b"}) {
     const auto before = EmcyCountOf(encoder);
     ASSERT_TRUE(Cli({"fault", "inject", "bus-off", "--node", encoder}));
@@ -122,7 +122,8 @@ TEST_F(FleetEncoderTest, BusOffSends8140hAfterRecoveryAndKeepsItIn1003h) {
         kProductPatience))
         << fleet().Log();
     EXPECT_TRUE(WaitLog(EmcyLine(encoder, 0x8140, 0x01, "00 00 00 00 00"))) << fleet().Log();
-    EXPECT_EQ(Sdo(encoder, "0x1003", 1, "u32"), 0x00008140u) << encoder;
+    // 00008140h left 1003h with the reset (README "EMCY codes": an entry leaves when its error clears).
+    EXPECT_EQ(Sdo(encoder, "0x1003", 0, "u8"), 0u) << encoder;
     EXPECT_EQ(Sdo(encoder, "0x1001", 0, "u8"), 0u) << encoder;
   }
   // C3-1.2.11: encoder-b pre-operational with OUT1 off (choice 7); encoder-a unchanged.

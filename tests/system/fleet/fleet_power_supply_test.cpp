@@ -109,7 +109,8 @@ TEST_F(FleetPowerSupplyTest, BusOffSends8140hAfterRecoveryGoesPreOperationalOutp
       kProductPatience))
       << fleet().Log();
   EXPECT_TRUE(WaitLog(EmcyLine("psu", 0x8140, 0x01, "00 00 00 00 00"))) << fleet().Log();
-  EXPECT_EQ(Sdo("psu", "0x1003", 1, "u32"), 0x00008140u);  // kept as the record of the event
+  // §2.2.4: the entry "is immediately removed when the error condition has been cleared".
+  EXPECT_EQ(Sdo("psu", "0x1003", 0, "u8"), 0u);
   EXPECT_EQ(Sdo("psu", "0x1001", 0, "u8"), 0u);
   EXPECT_TRUE(WaitNmt("psu", "pre-operational"));
   ExpectOutputUnchanged();

@@ -180,7 +180,8 @@ TEST_F(EmcyTest, LastSentAndOnSentReportAcceptedFrames) {
 
 // CiA 301 8140h means "recovered from bus-off": the EMCY raised while the controller is bus-off
 // cannot leave then, so it waits and is the first frame after recovery, followed by the error
-// reset sent when the error clears (CANopenNode's EMCY FIFO behaves the same).
+// reset sent when the error clears (CANopenNode's EMCY FIFO behaves the same). The reset takes the
+// entry out of 1003h like any other cleared error (CiA 301 §7.5.2.4; the manuals' 1003h sections).
 TEST_F(EmcyTest, EmcyRefusedDuringBusOffLeavesAfterRecoveryInOrder) {
   auto& emcy = Start();
   node.SetControllerState({ControllerState::kBusOff, 256, 0});
@@ -195,6 +196,8 @@ TEST_F(EmcyTest, EmcyRefusedDuringBusOffLeavesAfterRecoveryInOrder) {
   EXPECT_EQ(probe.Take(), (std::vector<std::string>{"085#4081110000000000", "085#2023130403000000",
                                                     "085#0000030000000000"}));
   EXPECT_FALSE(emcy.IsActive(0x8140, 0));
+  EXPECT_EQ(std::vector<std::uint32_t>(emcy.History().begin(), emcy.History().end()),
+            std::vector<std::uint32_t>{0x04032320u});
 }
 
 // Reset node: everything is forgotten without a frame (the node boots again).

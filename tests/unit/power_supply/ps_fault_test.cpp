@@ -333,20 +333,23 @@ TEST_F(PsFaultTest, RpdoTimeoutIs00008100) {
 }
 
 // Table 9: "00008140h ... Bus OFF Event" (the EMCY column's "8400h" is a slip: README choice 5).
-// The EMCY goes out once the controller is back; the entry stays in 1003h as the record of the
-// event; 1029h sub 1 = 0 → pre-operational.
+// The EMCY goes out once the controller is back, then the error reset, which removes the entry
+// from 1003h (§2.2.4: "immediately removed when the error condition has been cleared"; sub 0 is zero
+// in an error-free state); 1029h sub 1 = 0 → pre-operational.
 TEST_F(PsFaultTest, BusOffIs00008140) {
   Start();
   Frames();
   node_port_.SetControllerState({ControllerState::kBusOff, 256, 0});
   EXPECT_EQ(stack().State(), canopen::NmtState::kPreOperational);
   EXPECT_TRUE(Frames("0FF#").empty());
+  EXPECT_EQ(od().GetUnsigned(0x1003, 0), 1u);  // no SDO while bus-off: the dictionary itself
+  EXPECT_EQ(od().GetUnsigned(0x1003, 1), 0x00008140u);
   node_port_.SetControllerState({ControllerState::kErrorActive, 0, 0});
   Advance(1ms);
-  // "Recovered from bus-off" is an event: sent, then reset at once; 1003h keeps the record.
+  // "Recovered from bus-off": sent, then the error reset at once, and the entry leaves with it.
   EXPECT_EQ(Frames("0FF#"), (std::vector<std::string>{Emcy(0x8140, 0x01, 0x00, 0x00), EmcyReset()}));
   EXPECT_EQ(Read(0x1001, 0), 0);
-  EXPECT_EQ(Entry(1), 0x00008140u);
+  EXPECT_EQ(Read(0x1003, 0), 0);
 }
 
 }  // namespace

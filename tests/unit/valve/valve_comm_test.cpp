@@ -60,7 +60,9 @@ TEST_F(ValveCommTest, RpdoTimeoutAppliesTheOutputFaultReaction) {
   EXPECT_EQ(Read(0x1003, 0), 0);
 }
 
-// Table 33: bus-off -> 00008140h (the EMCY column's 8400h is not used, README); 1029h sub 1.
+// Table 33: bus-off -> 00008140h (the EMCY column's 8400h is not used, README); 1029h sub 1. The
+// EMCY goes out after the recovery, then the error reset, which removes the entry (§3.2.4:
+// "immediately removed when the error condition has been cleared", sub 0 zero when error-free).
 TEST_F(ValveCommTest, BusOff) {
   Write(0x1029, 1, 0, 1);
   Start();
@@ -71,7 +73,9 @@ TEST_F(ValveCommTest, BusOff) {
   EXPECT_EQ(od().GetUnsigned(0x1001, 0), 0x01u);
   port().SetControllerState({ControllerState::kErrorActive, 0, 0});
   Advance(10ms);
-  EXPECT_EQ(Frames("085#").front(), Emcy(0x8140, 0x01, 0, 0x00));
+  EXPECT_EQ(Frames("085#"), (std::vector<std::string>{Emcy(0x8140, 0x01, 0, 0x00), "085#0000000000000000"}));
+  EXPECT_EQ(Read(0x1003, 0), 0);
+  EXPECT_EQ(od().GetUnsigned(0x1001, 0), 0x00u);
 }
 
 // §3.2.4: "a maximum of 4 errors in the list ... the oldest entries will be lost".

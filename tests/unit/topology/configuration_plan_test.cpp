@@ -1,13 +1,22 @@
-// What the orchestrator writes into a node after its boot-up (orchestrator/fleet/configuration_plan).
-#include "orchestrator/fleet/configuration_plan.hpp"
+// What the orchestrator writes into a node after its boot-up (orchestrator/topology/configuration_plan).
+#include "orchestrator/topology/configuration_plan.hpp"
 
 #include <google/protobuf/text_format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-namespace canfleet::fleet {
+namespace canfleet::topology {
 namespace {
+
+// A node's topology entry with its ports' buses and node-IDs, as the fleet knows it.
+struct FleetNode {
+  Node spec;
+  std::vector<std::string> buses;
+  std::vector<std::uint8_t> node_ids;
+};
+
+std::optional<std::uint8_t> Lookup(const std::string& name, const std::string& bus);
 
 FleetNode NodeFrom(const std::string& text) {
   FleetNode node;
@@ -16,6 +25,10 @@ FleetNode NodeFrom(const std::string& text) {
   for (const auto id : node.spec.node_id())
     node.node_ids.push_back(static_cast<std::uint8_t>(id));
   return node;
+}
+
+std::vector<PlannedWrite> Plan(const FleetNode& node, std::size_t port) {
+  return PlanConfiguration(node.spec, node.buses, node.node_ids, port, Lookup);
 }
 
 std::optional<std::uint8_t> Lookup(const std::string& name, const std::string& bus) {
@@ -27,7 +40,7 @@ TEST(ConfigurationPlan, HeartbeatProducerThenConsumersThenSdoWritesInOrder) {
   const auto node = NodeFrom(R"(name: "quad-6" node_id: 6 bus: "can0"
     heartbeat { producer_ms: 500 consumer { node: "quad-5" timeout_ms: 1500 } consumer { node_id: 9 timeout_ms: 100 } }
     sdo { index: 0x1400 subindex: 5 type: "u16" value: "250" })");
-  const auto plan = PlanConfiguration(node, 0, Lookup);
+  const auto plan = Plan(node, 0);
   ASSERT_EQ(plan.size(), 4u);
   EXPECT_EQ(plan[0].index, 0x1017);
   EXPECT_EQ(plan[0].data, (std::vector<std::uint8_t>{0xF4, 0x01}));
@@ -40,23 +53,29 @@ TEST(ConfigurationPlan, HeartbeatProducerThenConsumersThenSdoWritesInOrder) {
   EXPECT_EQ(plan[3].index, 0x1400);
   EXPECT_EQ(plan[3].subindex, 5);
   EXPECT_EQ(plan[3].data, (std::vector<std::uint8_t>{0xFA, 0x00}));
+  // Each write names the field it comes from (the loader's warnings point there).
+  EXPECT_EQ(plan[0].source.field, PlanSource::Field::kProducer);
+  EXPECT_EQ(plan[2].source.field, PlanSource::Field::kConsumer);
+  EXPECT_EQ(plan[2].source.index, 1);
+  EXPECT_EQ(plan[3].source.field, PlanSource::Field::kSdo);
+  EXPECT_EQ(plan[3].source.index, 0);
 }
 
 TEST(ConfigurationPlan, NothingConfiguredMeansNoWrites) {
-  EXPECT_TRUE(PlanConfiguration(NodeFrom(R"(name: "a" node_id: 1 bus: "can0")"), 0, Lookup).empty());
+  EXPECT_TRUE(Plan(NodeFrom(R"(name: "a" node_id: 1 bus: "can0")"), 0).empty());
 }
 
 TEST(ConfigurationPlan, SdoWritesGoToTheirPort) {
   const auto node = NodeFrom(R"(name: "logger" node_id: 1 bus: "can0" bus: "can1"
     sdo { index: 0x1017 type: "u16" value: "100" port: 1 })");
-  EXPECT_TRUE(PlanConfiguration(node, 0, Lookup).empty());
-  EXPECT_EQ(PlanConfiguration(node, 1, Lookup).size(), 1u);
+  EXPECT_TRUE(Plan(node, 0).empty());
+  EXPECT_EQ(Plan(node, 1).size(), 1u);
 }
 
 TEST(ConfigurationPlan, ConsumerOfANodeOnAnotherBusIsRefused) {
   const auto node = NodeFrom(R"(name: "x" node_id: 2 bus: "can1"
     heartbeat { consumer { node: "quad-5" timeout_ms: 100 } })");
-  EXPECT_THROW(PlanConfiguration(node, 0, Lookup), std::invalid_argument);
+  EXPECT_THROW(Plan(node, 0), std::invalid_argument);
 }
 
 TEST(ConfigurationPlan, DcfValuesThatDifferFromTheDefaultsAreWritten) {
@@ -86,11 +105,11 @@ PDOMapping=0
 )";
   auto node = NodeFrom(R"(name: "a" node_id: 3 bus: "can0")");
   node.spec.set_dcf(dcf);
-  const auto plan = PlanConfiguration(node, 0, Lookup);
+  const auto plan = Plan(node, 0);
   ASSERT_EQ(plan.size(), 1u);
   EXPECT_EQ(plan[0].index, 0x1017);
   EXPECT_EQ(plan[0].data, (std::vector<std::uint8_t>{0xFA, 0x00}));
 }
 
 }  // namespace
-}  // namespace canfleet::fleet
+}  // namespace canfleet::topology
