@@ -24,8 +24,8 @@ export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 topology=${1:-topologies/demo.textproto}
 
 scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+# The same configuration as scripts/test.sh (CMakePresets.json "default"): one build folder for both.
+cmake --preset default >/dev/null
 cmake --build build -j "$(nproc)" --target canfleet canfleet-node
 
 bin=build/bin

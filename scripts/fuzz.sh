@@ -5,6 +5,9 @@
 #   scripts/fuzz.sh --minutes N [TARGET...]     long mode: N minutes per target (default: all), then
 #                                               the figures go into fuzz/README.md and the minimised
 #                                               corpus into fuzz/corpus/<target>/ (N = 0: only that)
+#   --build DIR                                 use the fuzz targets of the configured build folder
+#                                               DIR (scripts/test.sh's smoke: build-asan, -O0);
+#                                               default: build-fuzz, CMakePresets.json "fuzz" (-O2)
 #
 # Where inputs live (see fuzz/README.md):
 #   fuzz/seeds/<target>/    hand-written seeds, each one a case someone meant
@@ -22,6 +25,7 @@ export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 
 seconds=15
 minutes=""
+build=""
 only=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -29,8 +33,12 @@ while [ $# -gt 0 ]; do
       minutes=${2:?--minutes needs a number}
       shift 2
       ;;
+    --build)
+      build=${2:?--build needs a build folder}
+      shift 2
+      ;;
     --help | -h)
-      sed -n '2,17p' "$0"
+      sed -n '2,20p' "$0"
       exit 0
       ;;
     [0-9]*)
@@ -64,30 +72,36 @@ if [ ${#only[@]} -gt 0 ]; then
   names=("${only[@]}")
 fi
 
-# -O2 with the sanitizers: an -O0 build ran ten times fewer inputs in the same time. No NDEBUG:
-# assertions stay on. Frame pointers and line tables keep the sanitizers' reports readable.
-flags="-O2 -gline-tables-only -fno-omit-frame-pointer"
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="$flags" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$flags" \
-  -DCANFLEET_FUZZ=ON -DCANFLEET_BUILD_TESTS=OFF \
-  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache >/dev/null
-cmake --build build-fuzz -j "${FUZZ_JOBS:-$(nproc)}" --target "${names[@]/#/fuzz_}"
+if [ -z "$build" ]; then
+  # CMakePresets.json "fuzz": clang -O2 with ASan+UBSan (an -O0 build runs ten times fewer inputs).
+  build=build-fuzz
+  cmake --preset fuzz >/dev/null
+fi
+[ -f "$build/CMakeCache.txt" ] || {
+  echo "fuzz: $build is not a configured build folder" >&2
+  exit 2
+}
+grep -q '^CANFLEET_FUZZ:BOOL=ON' "$build/CMakeCache.txt" || {
+  echo "fuzz: $build was configured without CANFLEET_FUZZ=ON (presets \"fuzz\" and \"asan\" have it)" >&2
+  exit 2
+}
+cmake --build "$build" -j "${FUZZ_JOBS:-$(nproc)}" --target "${names[@]/#/fuzz_}"
 
 # One figures file and one log per target per invocation: two long runs may run side by side (one
 # per core), of different targets or of the same one (they share its cache corpus, as libFuzzer's
 # own -jobs do); each minimises and adds its rows to fuzz/README.md under a lock at the end.
-figures=$(mktemp build-fuzz/figures.XXXXXX.tsv)
+figures=$(mktemp "$build/figures.XXXXXX.tsv")
 failed=()
 for name in "${names[@]}"; do
   [ "$seconds" = 0 ] && break
-  bin=build-fuzz/fuzz/fuzz_$name
+  bin=$build/fuzz/fuzz_$name
   corpus=$cache/$name
   mkdir -p "$corpus"
   dirs=("$corpus")
   for d in "fuzz/corpus/$name" "fuzz/seeds/$name"; do
     [ -d "$d" ] && dirs+=("$d")
   done
-  log=$(mktemp "build-fuzz/fuzz_$name.XXXXXX.log")
+  log=$(mktemp "$build/fuzz_$name.XXXXXX.log")
   echo "fuzz: $name for ${seconds}s (corpus $corpus)"
   # -timeout: an input that runs 25 s is a hang (the slowest seed takes well under a second).
   if ! "$bin" -max_total_time="$seconds" -timeout=25 -print_final_stats=1 "${dirs[@]}" 2>"$log"; then
@@ -116,23 +130,23 @@ done
 # ten times more files for the same edges.)
 minimise() { # TARGET: rewrites fuzz/corpus/TARGET, prints the number of files kept
   # Under the lock below: a run of the same target beside this one minimises after or before it.
-  local name=$1 bin=build-fuzz/fuzz/fuzz_$1 work=build-fuzz/merge/$1 ctl=build-fuzz/merge/$1.ctl
-  local snapshot=build-fuzz/merge/$1.cache
+  local name=$1 bin=$build/fuzz/fuzz_$1 work=$build/merge/$1 ctl=$build/merge/$1.ctl
+  local snapshot=$build/merge/$1.cache
   rm -rf "$work" "$ctl" "$snapshot"
-  mkdir -p "$work" "build-fuzz/merge/$name.new"
+  mkdir -p "$work" "$build/merge/$name.new"
   [ -d "fuzz/seeds/$name" ] && cp "fuzz/seeds/$name"/* "$work"/
   # A snapshot of the cache corpus (hard links): a run of the same target still fuzzing beside this
   # one replaces inputs it reduces, and the merge must not look for a file that has gone since.
   cp -al "$cache/$name" "$snapshot" 2>/dev/null || { rm -rf "$snapshot" && cp -a "$cache/$name" "$snapshot"; }
   local from=("$snapshot")
   [ -d "fuzz/corpus/$name" ] && from+=("fuzz/corpus/$name")
-  "$bin" -merge=1 -timeout=25 -merge_control_file="$ctl" "$work" "${from[@]}" 2>"build-fuzz/merge_$name.log" || {
-    tail -30 "build-fuzz/merge_$name.log" >&2
+  "$bin" -merge=1 -timeout=25 -merge_control_file="$ctl" "$work" "${from[@]}" 2>"$build/merge_$name.log" || {
+    tail -30 "$build/merge_$name.log" >&2
     return 1
   }
-  rm -rf "build-fuzz/merge/$name.new"
-  mkdir -p "build-fuzz/merge/$name.new"
-  python3 - "$ctl" "build-fuzz/merge/$name.new" <<'PY'
+  rm -rf "$build/merge/$name.new"
+  mkdir -p "$build/merge/$name.new"
+  python3 - "$ctl" "$build/merge/$name.new" <<'PY'
 import hashlib, shutil, sys
 lines = open(sys.argv[1], errors="replace").read().splitlines()
 count, first = int(lines[0]), int(lines[1])
@@ -144,13 +158,13 @@ for line in lines[2 + count:]:
         open(sys.argv[2] + "/" + hashlib.sha1(data).hexdigest(), "wb").write(data)
 PY
   rm -rf "fuzz/corpus/$name" "$snapshot"
-  mv "build-fuzz/merge/$name.new" "fuzz/corpus/$name"
+  mv "$build/merge/$name.new" "fuzz/corpus/$name"
   find "fuzz/corpus/$name" -type f | wc -l
 }
 
 # The minimised corpus and the table in fuzz/README.md, under a lock: a run beside this one (of
 # another target or the same) does not minimise or write at the same time.
-exec 9>build-fuzz/readme.lock
+exec 9>"$build/readme.lock"
 flock 9
 if [ "$minutes" = 0 ]; then # --minutes 0: only re-minimise (after a change of the cover rule)
   for name in "${names[@]}"; do

@@ -19,7 +19,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
-  python3 python3-venv can-utils
+  python3 python3-venv can-utils jq
   qemu-system-x86 busybox-static cpio iproute2 xz-utils zstd
   tshark
   debootstrap
@@ -34,6 +34,7 @@ programs=(
   python3:python3                                                          # scripts, conformance, fuzz.sh
   candump:can-utils cansend:can-utils log2long:can-utils                   # capture and vcan tests
   tshark:tshark                                                            # capture dissector test
+  jq:jq                                                                    # README examples (tests/docs)
   ip:iproute2                                                              # vcan tests (ip link add ... type vcan)
   qemu-system-x86_64:qemu-system-x86 busybox:busybox-static cpio:cpio      # scripts/vm-can-test.sh
   xz:xz-utils zstd:zstd gzip:gzip                                          # vm-can-test.sh: kernel modules, initramfs

@@ -22,7 +22,7 @@ class Ds401FixtureTest : public ::testing::Test {
   const SubObject& Sub(std::uint16_t index, std::uint8_t sub) {
     const SubObject* found = eds.od.Find(index, sub);
     EXPECT_NE(found, nullptr) << std::hex << index << "sub" << int{sub};
-    static const SubObject kMissing;
+    static const SubObject kMissing{};
     return found ? *found : kMissing;
   }
 
