@@ -55,7 +55,10 @@ def test_passes(fleet):
 def inner_pytest(tmp_path: Path, source: str, *args: str) -> "subprocess.Popen[str]":
     test = tmp_path / "test_inner.py"
     test.write_text(source)
-    env = dict(os.environ, TOPOLOGY=str(PAIR), PIDS_FILE=str(tmp_path / "pids"), PYTHONDONTWRITEBYTECODE="1")
+    # TMPDIR: the inner fleets' state folders go below tmp_path, so that a killed run (which
+    # removes nothing) leaves them where pytest cleans up.
+    env = dict(os.environ, TOPOLOGY=str(PAIR), PIDS_FILE=str(tmp_path / "pids"), PYTHONDONTWRITEBYTECODE="1",
+               TMPDIR=str(tmp_path))
     return subprocess.Popen([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-rA", str(test), *args],
                             cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
