@@ -29,7 +29,7 @@ packages=(
 programs=(
   cmake:cmake ninja:ninja-build ccache:ccache pkg-config:pkg-config git:git # build (scripts/test.sh)
   c++:build-essential cc:build-essential                                   # the default toolchain
-  protoc:protobuf-compiler idlc:cyclonedds-tools                           # generated code (CMake)
+  protoc:protobuf-compiler idlc:cyclonedds-tools                           # generated code (CMake; python/setup.py)
   clang:clang clang++:clang clang-format:clang-format                      # scripts/fuzz.sh, formatting
   python3:python3                                                          # scripts, conformance, fuzz.sh
   candump:can-utils cansend:can-utils log2long:can-utils                   # capture and vcan tests

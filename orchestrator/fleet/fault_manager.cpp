@@ -53,9 +53,22 @@ double FaultManager::Seconds(TimePoint t) const {
 
 const FleetNode& FaultManager::Node(const std::string& name) const {
   if (name.empty()) throw FaultError("this fault needs --node");
-  const FleetNode* node = ctx_.find_node(name);
-  if (!node) throw FaultError("no node called '" + name + "' in this fleet");
-  return *node;
+  if (const FleetNode* node = ctx_.find_node(name)) return *node;
+  FleetNode participant;
+  participant.spec.set_name(name);
+  participant.device_label = "participant";
+  for (const auto& bus : ctx_.broker.Buses()) {
+    if (!ctx_.broker.NewestPortNamed(bus, name)) continue;
+    participant.buses.push_back(bus);
+    participant.node_ids.push_back(0);
+  }
+  if (participant.buses.empty())
+    throw FaultError("no node called '" + name + "' in this fleet (nor a participant of that name attached)");
+  return participants_[name] = std::move(participant);
+}
+
+bool FaultManager::IsParticipant(const FleetNode& node) const {
+  return ctx_.find_node(node.name()) == nullptr;
 }
 
 broker::PortId FaultManager::PortOf(const std::string& bus, const std::string& node) const {
@@ -186,6 +199,9 @@ void FaultManager::ApplyHeartbeatLoss(Fault& fault) {
   const FleetNode& node = Node(fault.spec.node());
   fault.bus = BusFor(fault.spec);
   const auto node_id = node.node_ids[static_cast<std::size_t>(node.PortOn(fault.bus))];
+  if (IsParticipant(node))
+    throw FaultError("'" + node.name() +
+                     "' is a participant, not a CANopen node: it has no heartbeat to lose");
   broker::FaultRule rule;
   rule.source = PortOf(fault.bus, node.name());
   rule.id = 0x700u + node_id;
@@ -304,6 +320,9 @@ void FaultManager::ApplyErrorPassive(Fault& fault) {
 
 void FaultManager::ApplyProcessFault(Fault& fault) {
   const FleetNode& node = Node(fault.spec.node());
+  if (IsParticipant(node))
+    throw FaultError("'" + node.name() +
+                     "' is a participant attached by name, not a node process of this fleet");
   if (node.external() || !ctx_.supervisor.Has(node.name()))
     throw FaultError("node '" + node.name() + "' runs elsewhere (external): the orchestrator cannot " +
                      "kill or restart its process");

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -76,7 +77,13 @@ class FaultManager {
   control::FaultStatus StatusOf(const Fault& fault) const;
   std::uint64_t Hits(const Fault& fault) const;
 
+  /// The topology's node called `name`, else a participant of that name: a client attached to the
+  /// broker by name that is no node of the topology (a test's python-can bus, python/README.md).
+  /// Bus and frame faults act on a participant's port as on a node's; it has no node-ID (no
+  /// heartbeat to lose) and no process of this fleet. Throws FaultError when neither exists.
   const FleetNode& Node(const std::string& name) const;
+  /// True when `node` is a participant (no node of the topology).
+  bool IsParticipant(const FleetNode& node) const;
   /// The node's broker port on `bus` (it must be attached now).
   broker::PortId PortOf(const std::string& bus, const std::string& node) const;
   std::string BusFor(const control::FaultSpec& spec) const;
@@ -86,6 +93,8 @@ class FaultManager {
   Context ctx_;
   std::vector<std::unique_ptr<Fault>> faults_;  ///< in injection order; ended ones stay for List
   std::uint32_t next_id_ = 1;
+  /// Participants as Node() last found them (a std::map: references stay valid as it grows).
+  mutable std::map<std::string, FleetNode> participants_;
 };
 
 }  // namespace canfleet::fleet

@@ -78,6 +78,15 @@ int RunFleet(const UpOptions& options) {
     spec.mutable_orchestrator()->clear_listen();
     spec.mutable_orchestrator()->add_listen(*options.listen);
   }
+  if (options.state_root) {
+    const std::filesystem::path old_root = spec.orchestrator().state_root();
+    const std::filesystem::path root = std::filesystem::absolute(*options.state_root);
+    spec.mutable_orchestrator()->set_state_root(root.string());
+    for (auto& node : *spec.mutable_node())
+      if (std::filesystem::path(node.state_dir()) == old_root / node.name())
+        node.set_state_dir((root / node.name()).string());
+  }
+  if (options.seed) spec.mutable_time()->set_seed(*options.seed);
 
   spdlog::set_level(spdlog::level::from_str(options.log_level));
   // What the loader found that cannot work (topology_warnings.hpp), and each bus's periodic load.

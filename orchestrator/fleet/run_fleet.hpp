@@ -26,6 +26,11 @@ struct UpOptions {
   /// Where the orchestrator publishes (canfleet up's --dds-* options); also passed to its nodes.
   telemetry::DdsOptions dds;
   TimeOverride time;  ///< --time / --speed; empty: the topology's time
+  /// --state-dir: the fleet's state root (node state and logs) instead of the topology's
+  /// state_root; nodes whose state_dir was the default follow it (as `canfleet test` does).
+  std::optional<std::filesystem::path> state_root;
+  /// --seed: seeds the faults that give no seed of their own (overrides the topology's time.seed).
+  std::optional<std::uint64_t> seed;
 };
 
 /// The node processes of a fleet of `spec`: one per node, started by the fleet or (external)

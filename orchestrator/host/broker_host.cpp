@@ -27,9 +27,10 @@ std::unique_ptr<transport::TimeConductor> MakeConductor(asio::io_context& io, Sc
                                                     time.conductor);
 }
 
-transport::BrokerServerOptions ServerOptions(transport::TimeConductor* conductor) {
+transport::BrokerServerOptions ServerOptions(transport::TimeConductor* conductor, WallTime wall_origin) {
   transport::BrokerServerOptions options;
   options.time_conductor = conductor;
+  options.wall_origin = wall_origin;
   return options;
 }
 
@@ -55,7 +56,7 @@ BrokerHost::BrokerHost(asio::io_context& io, socketcand::ServerOptions socketcan
       wall_origin_(time.virtual_time ? WallTime{} : WallClockOrigin(*scheduler_)),
       broker_(*scheduler_),
       conductor_(MakeConductor(io, *scheduler_, broker_, time)),
-      server_(io, broker_, ServerOptions(conductor_.get())),
+      server_(io, broker_, ServerOptions(conductor_.get(), wall_origin_)),
       socketcand_(io, broker_, *scheduler_, WithOrigin(std::move(socketcand_options), wall_origin_)),
       signals_(io, SIGINT, SIGTERM),
       drain_(io) {}

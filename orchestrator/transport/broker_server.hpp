@@ -18,6 +18,7 @@
 
 #include "bus/wire/endpoint.hpp"
 #include "bus/wire/messages.hpp"
+#include "clock/wall_clock.hpp"
 #include "orchestrator/broker/broker.hpp"
 
 namespace canfleet::transport {
@@ -41,6 +42,10 @@ struct BrokerServerOptions {
   /// Lock-step virtual time (time_conductor.hpp): the conductor of every bus of this broker, which
   /// must outlive the server. nullptr: real time.
   TimeConductor* time_conductor = nullptr;
+  /// The wall-clock time of bus time 0 (clock/wall_clock.hpp), told to every client in its
+  /// HelloReply (wall_origin_ns) so that it stamps received frames as captures do. The epoch (0)
+  /// in virtual time and when unknown.
+  WallTime wall_origin{};
 };
 
 struct BrokerServerStats {

@@ -333,6 +333,7 @@ void NodeSession::Accept(const wire::Hello& hello) {
   reply.set_bitrate(bus.bitrate);
   reply.set_mode(bus.paced ? wire::BUS_MODE_PACED : wire::BUS_MODE_UNPACED);
   reply.set_port_id(port_);
+  reply.set_wall_origin_ns(options_.wall_origin.time_since_epoch().count());
   if (conductor != nullptr) {
     reply.set_virtual_time(true);
     reply.set_time_ns(conductor->Now().time_since_epoch().count());

@@ -461,6 +461,38 @@ TEST_F(Transport, BrokerAnswersPing) {
   EXPECT_EQ(replies[2].envelope.pong().nonce(), 8u);
 }
 
+// A client that stamps received frames as captures and socketcand do (the Python participant) learns
+// the wall-clock time of bus time 0 from its HelloReply (canfleet_wire.proto, HelloReply.wall_origin_ns).
+TEST_F(Transport, HelloReplyCarriesTheWallClockOriginOfBusTime) {
+  transport::BrokerServerOptions options;
+  options.wall_origin = WallTime(std::chrono::nanoseconds(1'700'000'000'123'456'789));
+  transport::BrokerServer server(io_, broker_, options);
+  const std::string ep = Listen(server);
+  std::optional<wire::Message> reply;  // written by the peer thread until `done`
+  std::atomic<bool> done = false;
+  std::thread peer([&] {
+    RawConnection raw(ep);
+    wire::MessageWriter w;
+    w.AddHello(wire::MakeHello("can0", "stamper"));
+    raw.Send(std::vector<std::uint8_t>(w.Bytes().begin(), w.Bytes().end()));
+    wire::StreamDecoder decoder;
+    wire::Message m;
+    while (!reply) {
+      const auto got = raw.ReadAtLeast(1);
+      if (got.bytes.empty()) break;
+      decoder.Feed(got.bytes);
+      if (decoder.Next(m) == wire::StreamDecoder::Result::kMessage) reply = m;
+    }
+    done = true;
+  });
+  ASSERT_TRUE(RunUntil([&] { return done.load(); }));
+  peer.join();
+  ASSERT_TRUE(reply);
+  ASSERT_EQ(reply->type, wire::MessageType::kHelloReply);
+  EXPECT_TRUE(reply->envelope.hello_reply().accepted());
+  EXPECT_EQ(reply->envelope.hello_reply().wall_origin_ns(), 1'700'000'000'123'456'789);
+}
+
 // ---- NodeRequest / NodeReply (remote I/O) -------------------------------------------------------
 
 wire::NodeRequest IoGetRequest(std::uint64_t id, const std::string& name) {

@@ -1,6 +1,7 @@
 // canfleet up FILE, canfleet down, canfleet check FILE.
 #include <iostream>
 #include <memory>
+#include <optional>
 #include "telemetry/cli_options.hpp"
 
 #include "orchestrator/fleet/fleet_time.hpp"
@@ -21,8 +22,10 @@ struct UpArgs {
   std::string log_level = "info";
   bool no_start = false;
   bool telemetry = true;
-  std::string time;   ///< "" = the topology's
-  std::string speed;  ///< "" = the topology's
+  std::string time;       ///< "" = the topology's
+  std::string speed;      ///< "" = the topology's
+  std::string state_dir;  ///< "" = the topology's state_root
+  std::optional<std::uint64_t> seed;
   telemetry::DdsOptions dds;
 };
 
@@ -39,6 +42,8 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.telemetry = args.telemetry;
   options.dds = args.dds;
   options.time.mode = args.time;
+  if (!args.state_dir.empty()) options.state_root = args.state_dir;
+  options.seed = args.seed;
   if (!args.speed.empty()) {
     try {
       options.time.speed = fleet::ParseSpeed(args.speed);
@@ -111,6 +116,11 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
       "--speed", args->speed,
       "Virtual time: max (as fast as the processes go) or simulated seconds per real second, e.g. 10 "
       "(default: the topology's time.speed, else max)");
+  up->add_option("--state-dir", args->state_dir,
+                 "Folder for the nodes' state and logs, instead of the topology's state_root (a private "
+                 "fleet: tests, python/canfleet)");
+  up->add_option("--seed", args->seed,
+                 "Seed of the random draws of faults that give none (overrides the topology's time.seed)");
   up->add_flag("!--no-telemetry", args->telemetry, "Do not publish BusStats and FaultEvents over DDS");
   telemetry::AddDdsOptions(*up, args->dds, telemetry::DdsDiscovery::kMonitorsOnly);
   up->callback([&cli, args] { cli.action = [&cli, args] { return RunUp(cli.global, *args); }; });

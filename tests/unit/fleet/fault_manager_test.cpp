@@ -267,5 +267,41 @@ TEST_F(FaultManagerTest, BabblingIdiotKeepsTheNodesQueueFull) {
   EXPECT_GT(hits, 100u);
 }
 
+// A participant (a client attached by name that is no node of the topology, e.g. a test's python-can
+// bus, python/README.md): controller and frame faults act on its port as on a node's; what needs a
+// CANopen node-ID or a process of the fleet is refused with a reason.
+TEST_F(FaultManagerTest, AParticipantAttachedByNameTakesBusAndFrameFaultsButNotNodeFaults) {
+  NullSink participant_sink;
+  const auto participant = broker.Attach("can0", "pytest-bus", participant_sink);
+  faults->Inject(Spec(control::BUS_OFF, "pytest-bus"));
+  scheduler.Advance(1ms);
+  EXPECT_EQ(broker.Port(participant).controller.state, ControllerState::kBusOff);
+  EXPECT_EQ(participant_sink.state, ControllerState::kBusOff);
+
+  auto drop = Spec(control::DROP, "pytest-bus");
+  drop.set_cob_id(0x601);
+  faults->Inject(drop);
+  const auto rules = broker.Faults("can0").List();
+  ASSERT_EQ(rules.size(), 1u);
+  EXPECT_EQ(rules[0].rule.source, std::optional<broker::PortId>(participant));
+
+  try {
+    faults->Inject(Spec(control::HEARTBEAT_LOSS, "pytest-bus"));
+    ADD_FAILURE() << "heartbeat-loss of a participant was accepted";
+  } catch (const FaultError& e) {
+    EXPECT_NE(std::string(e.what()).find("participant, not a CANopen node"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(faults->Inject(Spec(control::KILL, "pytest-bus")), FaultError);
+  try {
+    faults->Inject(Spec(control::BUS_OFF, "ghost"));
+    ADD_FAILURE() << "a fault on a name nobody has was accepted";
+  } catch (const FaultError& e) {
+    EXPECT_NE(std::string(e.what()).find("no node called 'ghost'"), std::string::npos) << e.what();
+  }
+  // Gone from the bus, it is nobody.
+  broker.Detach(participant);
+  EXPECT_THROW(faults->Inject(Spec(control::ERROR_PASSIVE, "pytest-bus")), FaultError);
+}
+
 }  // namespace
 }  // namespace canfleet::fleet
