@@ -68,8 +68,10 @@ class Judge {
   /// One line: "EMCY 8130h from quad-6".
   virtual std::string Describe() const = 0;
 
-  /// The window opens (`open` = now) and will close at `close` (== open: judged on the first
-  /// observation). `origin` is the scenario's start, for messages.
+  /// The window opens and will close at `close` (== open: judged on the first observation).
+  /// `open` is the window's time, which may have passed (the runner then hands it the frames seen
+  /// since) or lie a little ahead (a frame's end-of-frame time). `origin` is the scenario's start,
+  /// for messages.
   void Open(TimePoint origin, TimePoint open, TimePoint close);
   /// A frame (or error frame) seen on `bus` at `time`.
   void Frame(const std::string& bus, const CanFrame& frame, TimePoint time);

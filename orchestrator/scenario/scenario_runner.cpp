@@ -1,5 +1,6 @@
 #include "orchestrator/scenario/scenario_runner.hpp"
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -14,6 +15,10 @@ struct ScenarioRunner::Expectation {
   std::size_t port_index = 0;
   std::string name, description;
   std::optional<TimePoint> opened;
+  /// The frame its anchor saw: its window judges the frames of that bus behind it, not it.
+  std::optional<FrameRef> after_frame;
+  /// The frame that decided it (unset: a read, or its window's close).
+  std::optional<FrameRef> decided_by;
   Verdict skipped;  ///< set when it cannot be judged (its anchor failed)
   bool scheduled = false, reading = false, closing = false, reported = false;
   std::unique_ptr<Timer> open_timer, poll_timer, close_timer, grace_timer;
@@ -81,6 +86,8 @@ std::string WindowText(const topology::Step& step, const std::string& what) {
 ScenarioRunner::ScenarioRunner(Scheduler& scheduler, const topology::Topology& topology, FleetProbe& probe,
                                Hooks hooks, RunnerOptions options)
     : scheduler_(scheduler), topology_(topology), probe_(probe), hooks_(std::move(hooks)), options_(options) {
+  for (const auto& bus : topology_.bus())
+    buses_.push_back(bus.name());
   std::map<std::string, int> named;
   auto namer = [this](const std::string& bus, std::uint8_t id) -> std::string {
     for (const auto& node : topology_.node())
@@ -148,11 +155,12 @@ void ScenarioRunner::Start() {
   CheckDone();
 }
 
-void ScenarioRunner::Anchored(int step, TimePoint anchor) {
+void ScenarioRunner::Anchored(int step, TimePoint anchor, std::optional<FrameRef> by) {
   for (auto& ptr : expects_) {
     Expectation& e = *ptr;
     if (e.anchor != step || e.scheduled || e.decided()) continue;
     e.scheduled = true;
+    e.after_frame = by;
     const TimePoint open = anchor + std::chrono::milliseconds(e.spec->at_ms());
     e.open_timer = std::make_unique<Timer>(scheduler_, [this, &e, open] {
       e.opened = open;
@@ -161,7 +169,8 @@ void ScenarioRunner::Anchored(int step, TimePoint anchor) {
     // A window already due, or one that opens at its anchor, opens now, not on a timer: the
     // frames that follow the anchor's in the same delivery (an error reset right after the EMCY it
     // resets) must find it open, and a paced bus delivers a round's frames with their end-of-frame
-    // times, which may lie a little ahead of the scheduler's now.
+    // times, which may lie a little ahead of the scheduler's now (or, when its timer fired late,
+    // behind it: OpenWindow).
     if (open <= scheduler_.Now() || e.spec->at_ms() == 0) {
       e.opened = open;
       OpenWindow(e);
@@ -184,11 +193,19 @@ void ScenarioRunner::AnchorLost(int step, const std::string& why) {
 
 void ScenarioRunner::OpenWindow(Expectation& e) {
   const TimePoint now = scheduler_.Now();
-  const TimePoint open = std::max(*e.opened, now);
-  const TimePoint close = std::max(open, *e.opened + std::chrono::milliseconds(e.spec->expect().within_ms()));
+  const auto within = std::chrono::milliseconds(e.spec->expect().within_ms());
+  // A window opens at its time even when that has passed (a timer or a round of the bus that ran
+  // late, an anchor decided by a read answered later): every frame the monitor saw from then on
+  // counts, those already given (Replay) and those still to come, whenever they come. An instant
+  // (within_ms 0) is judged on its first observation, which a read can make only now. A window
+  // never closes before the runner opened it, so that a read can still look.
+  const TimePoint open = within.count() == 0 ? std::max(*e.opened, now) : *e.opened;
+  const TimePoint close = std::max({open, now, *e.opened + within});
   e.judge->Open(origin_, open, close);
   e.close_timer = std::make_unique<Timer>(scheduler_, [this, &e] { CloseWindow(e); });
   e.close_timer->StartAt(close);
+  Replay(e);
+  if (e.judge->decided()) return Finish(e);
   const Poll needs = e.judge->Needs();
   if (needs != Poll::kNone) {
     const Duration period =
@@ -203,6 +220,17 @@ void ScenarioRunner::OpenWindow(Expectation& e) {
     PollOnce(e);
   }
   if (e.judge->decided()) Finish(e);
+}
+
+void ScenarioRunner::Replay(Expectation& e) {
+  for (std::size_t i = 0; i < history_size_ && !e.judge->decided(); ++i) {
+    const Heard& heard = HistoryAt(i);
+    // The anchor's frame and those before it on its bus (same time on an unpaced bus) are not
+    // behind it; frames of other buses count from the window's time (the judge's window).
+    if (e.after_frame && heard.ref.bus == e.after_frame->bus && heard.ref.seq <= e.after_frame->seq) continue;
+    e.judge->Frame(buses_[heard.ref.bus], heard.frame, heard.time);
+    if (e.judge->decided()) e.decided_by = heard.ref;
+  }
 }
 
 void ScenarioRunner::PollOnce(Expectation& e) {
@@ -298,7 +326,7 @@ void ScenarioRunner::Finish(Expectation& e) {
   const Verdict& v = e.verdict();
   if (!e.spec->name().empty()) {
     if (v.outcome == Outcome::kPassed)
-      Anchored(e.step, v.time);
+      Anchored(e.step, v.time, e.decided_by);
     else
       AnchorLost(e.step, v.outcome == Outcome::kFailed ? "failed" : "was not judged");
   }
@@ -306,17 +334,58 @@ void ScenarioRunner::Finish(Expectation& e) {
 }
 
 void ScenarioRunner::Frame(const std::string& bus, const CanFrame& frame, TimePoint time) {
-  // Only the windows open before this frame judge it: a window that opens because of it (timed
-  // after the expectation it decides) starts with the next one.
+  const Heard heard{{BusIndex(bus), next_seq_++}, frame, time};
+  // Only the windows open before this frame judge it here: a window that opens while it is judged
+  // (timed after the expectation it decides) finds it in the history (Replay), and judges it only
+  // if it is not the frame of its anchor (the window then starts with the next one).
   std::vector<Expectation*>& open = frame_targets_;
   open.clear();
-  for (auto& ptr : expects_)
-    if (ptr->opened && !ptr->reported) open.push_back(ptr.get());
+  bool waiting = false;
+  for (auto& ptr : expects_) {
+    if (ptr->reported) continue;
+    if (ptr->opened)
+      open.push_back(ptr.get());
+    else
+      waiting = true;
+  }
+  if (waiting)
+    Remember(heard);
+  else
+    history_size_ = 0;  // no window left to open
   for (Expectation* e : open) {
     if (e->reported) continue;
     e->judge->Frame(bus, frame, time);
-    if (e->judge->decided()) Finish(*e);
+    if (e->judge->decided()) {
+      e->decided_by = heard.ref;
+      Finish(*e);
+    }
   }
+}
+
+std::size_t ScenarioRunner::BusIndex(const std::string& bus) {
+  for (std::size_t i = 0; i < buses_.size(); ++i)
+    if (buses_[i] == bus) return i;
+  buses_.push_back(bus);
+  return buses_.size() - 1;
+}
+
+void ScenarioRunner::Remember(const Heard& heard) {
+  const TimePoint horizon = scheduler_.Now() - options_.frame_history;
+  while (history_size_ > 0 && history_[history_head_].time < horizon) {
+    history_head_ = (history_head_ + 1) % history_.size();
+    --history_size_;
+  }
+  if (history_size_ == history_.size()) {
+    std::vector<Heard> grown;
+    grown.reserve(std::max<std::size_t>(64, 2 * history_.size()));
+    for (std::size_t i = 0; i < history_size_; ++i)
+      grown.push_back(HistoryAt(i));
+    grown.resize(grown.capacity());
+    history_ = std::move(grown);
+    history_head_ = 0;
+  }
+  history_[(history_head_ + history_size_) % history_.size()] = heard;
+  ++history_size_;
 }
 
 std::vector<Result> ScenarioRunner::Results() const {

@@ -56,6 +56,11 @@ struct RunnerOptions {
   /// A read still unanswered this long after its window closed is given up (the judge decides
   /// on what it has).
   Duration read_grace = std::chrono::seconds(5);
+  /// How long (scheduler time before now) the runner keeps the frames it was given while a window
+  /// is still to open, so that a window opening later than its time judges the frames the monitor
+  /// saw since then: a timer that fired late, an anchor decided by a read answered after it was
+  /// asked (up to read_grace), a frame of another bus delivered before the anchor's.
+  Duration frame_history = std::chrono::seconds(5);
 };
 
 class ScenarioRunner {
@@ -76,7 +81,9 @@ class ScenarioRunner {
 
   /// The scenario starts now (the fleet is ready).
   void Start();
-  /// A frame seen on `bus` at `time` (bus time = scheduler time).
+  /// A frame seen on `bus` at `time` (bus time = scheduler time). Frames of one bus come in bus
+  /// order, with their bus times, however late (a round delivered in one batch by a timer that
+  /// fired late) or early (end-of-frame times ahead of now).
   void Frame(const std::string& bus, const CanFrame& frame, TimePoint time);
 
   /// Every expectation in file order; decided ones have their verdict.
@@ -91,9 +98,25 @@ class ScenarioRunner {
  private:
   struct Expectation;
   struct Action;
-  void Anchored(int step, TimePoint anchor);
+  /// Which frame: its bus (index in buses_) and its place in the order the runner was given them.
+  struct FrameRef {
+    std::size_t bus = 0;
+    std::uint64_t seq = 0;
+  };
+  /// A frame the runner was given, kept for windows that open after it came.
+  struct Heard {
+    FrameRef ref;
+    CanFrame frame;
+    TimePoint time{};
+  };
+  /// `by`: the frame the anchor saw (a window opened by it judges only the frames behind it).
+  void Anchored(int step, TimePoint anchor, std::optional<FrameRef> by = std::nullopt);
   void AnchorLost(int step, const std::string& why);
   void OpenWindow(Expectation& e);
+  void Replay(Expectation& e);
+  std::size_t BusIndex(const std::string& bus);
+  void Remember(const Heard& heard);
+  const Heard& HistoryAt(std::size_t i) const { return history_[(history_head_ + i) % history_.size()]; }
   void PollOnce(Expectation& e);
   void ReadDone(Expectation& e, const Sample& sample);
   void CloseWindow(Expectation& e);
@@ -111,6 +134,12 @@ class ScenarioRunner {
   std::vector<std::unique_ptr<Expectation>> expects_;
   std::vector<std::unique_ptr<Action>> actions_;
   std::vector<Expectation*> frame_targets_;  ///< Frame()'s list, kept to reuse its storage
+  std::vector<std::string> buses_;           ///< FrameRef::bus indexes it
+  std::uint64_t next_seq_ = 0;
+  /// The frames given while a window is still to open, oldest first from history_head_ (a ring,
+  /// so that keeping them allocates only while it grows).
+  std::vector<Heard> history_;
+  std::size_t history_head_ = 0, history_size_ = 0;
   /// Read callbacks that outlive the runner find it expired.
   std::shared_ptr<int> alive_ = std::make_shared<int>(0);
 };

@@ -174,6 +174,93 @@ scenario { name: "state" expect { after: "emcy" nmt { node: "quad-6" state: "ope
   EXPECT_EQ(Decided("state")->verdict.outcome, Outcome::kPassed);
 }
 
+// The power supply's bus-off (topologies/scenarios/power-supply-24v-350w-bus-off.textproto) on a
+// loaded machine: the broker's timer fires late, so the EMCY 8140h and the error reset 1 ms behind
+// it reach the runner in one batch, both stamped before the scheduler's now. The window timed
+// after the 8140h opens at the 8140h's time, not at the late now, and judges the reset.
+TEST_F(ScenarioRunnerTest, AWindowAnchoredOnAFrameDeliveredLateJudgesTheFramesBehindIt) {
+  Run(R"(
+scenario { at_ms: 3000 name: "bus-off" inject { kind: BUS_OFF node: "quad-6" } }
+scenario { name: "emcy" expect { after: "bus-off" within_ms: 3000 emcy { node: "quad-6" code: 0x8140 } } }
+scenario { name: "reset" expect { after: "emcy" within_ms: 3000 emcy { node: "quad-6" code: 0x0000 } } }
+scenario { name: "quiet" expect { after: "emcy" within_ms: 100 no_emcy { code: 0x8140 } } }
+)");
+  scheduler_.Advance(3500ms + 7ms);  // the round of 3.500 s runs 7 ms late
+  runner_->Frame("can0", Emcy(6, 0x8140), T(3500ms));
+  runner_->Frame("can0", Emcy(6, 0x0000), T(3501ms));
+  ASSERT_NE(Decided("emcy"), nullptr);
+  ASSERT_NE(Decided("reset"), nullptr);
+  EXPECT_EQ(Decided("reset")->verdict.outcome, Outcome::kPassed) << Decided("reset")->verdict.detail;
+  EXPECT_EQ(Decided("reset")->verdict.time, T(3501ms));
+  EXPECT_EQ(*Decided("reset")->opened, T(3500ms));
+  EXPECT_EQ(Decided("quiet"), nullptr);  // not judged on the 8140h that opened it
+  scheduler_.Advance(100ms);
+  ASSERT_NE(Decided("quiet"), nullptr);
+  EXPECT_EQ(Decided("quiet")->verdict.outcome, Outcome::kPassed);
+}
+
+// A frame given before a window's timer fires (its end-of-frame time ahead of now, or a bus round
+// that ran before the runner's timer on a loaded machine) is judged when the window opens.
+TEST_F(ScenarioRunnerTest, AWindowOpenedByItsTimerJudgesTheFramesGivenBeforeIt) {
+  Run(R"(
+scenario { at_ms: 1000 name: "emcy" expect { within_ms: 500 emcy { node: "quad-6" code: 0x8140 } } }
+scenario { at_ms: 1000 name: "early" expect { within_ms: 500 emcy { node: "quad-6" code: 0x1000 } } }
+)");
+  scheduler_.Advance(999ms);
+  runner_->Frame("can0", Emcy(6, 0x1000), T(999ms));  // before its window
+  runner_->Frame("can0", Emcy(6, 0x8140), T(1000ms + 300us));
+  EXPECT_TRUE(decided_.empty());
+  scheduler_.Advance(1ms);
+  ASSERT_NE(Decided("emcy"), nullptr);
+  EXPECT_EQ(Decided("emcy")->verdict.outcome, Outcome::kPassed);
+  EXPECT_EQ(Decided("emcy")->verdict.time, T(1000ms + 300us));
+  EXPECT_EQ(Decided("early"), nullptr);
+  scheduler_.Advance(500ms);
+  EXPECT_EQ(Decided("early")->verdict.outcome, Outcome::kFailed);
+}
+
+// A read passes at the time it was asked; its answer comes later. A window timed after it judges
+// the frames seen between the question and the answer, which the runner was given before.
+TEST_F(ScenarioRunnerTest, AWindowAfterAReadJudgesTheFramesSeenWhileItsAnswerWasOut) {
+  Run(R"(
+scenario { at_ms: 100 name: "entry" expect { within_ms: 1000 sdo { node: "quad-6" index: 0x1001 type: "u8" value: "1" } } }
+scenario { name: "emcy" expect { after: "entry" within_ms: 500 emcy { node: "quad-6" code: 0x8140 } } }
+)");
+  scheduler_.Advance(100ms);
+  ASSERT_EQ(probe_.sdo_reads, 1);
+  runner_->Frame("can0", Emcy(6, 0x8140), T(99ms));  // before the question: not after the anchor
+  scheduler_.Advance(30ms);
+  runner_->Frame("can0", Emcy(6, 0x8140), T(120ms));
+  scheduler_.Advance(30ms);
+  probe_.AnswerSdo({0x01});
+  ASSERT_NE(Decided("entry"), nullptr);
+  EXPECT_EQ(Decided("entry")->verdict.time, T(100ms));
+  ASSERT_NE(Decided("emcy"), nullptr);
+  EXPECT_EQ(Decided("emcy")->verdict.outcome, Outcome::kPassed);
+  EXPECT_EQ(Decided("emcy")->verdict.time, T(120ms));
+}
+
+// Each bus has its own rounds: another bus's frames behind the anchor's time may have been given
+// before the anchor's own. They count; those before the anchor's time do not.
+TEST_F(ScenarioRunnerTest, AWindowAnchoredOnAFrameJudgesAnotherBusFromTheAnchorsTime) {
+  Run(R"(
+bus { name: "can1" }
+scenario { name: "emcy" expect { within_ms: 2000 emcy { node: "quad-6" code: 0x8140 } } }
+scenario { name: "after" expect { after: "emcy" within_ms: 100 frames { bus: "can1" cob_id: 0x181 at_least: 1 } } }
+scenario { name: "before" expect { after: "emcy" within_ms: 100 frames { bus: "can1" cob_id: 0x182 at_most: 0 } } }
+)");
+  scheduler_.Advance(305ms);
+  runner_->Frame("can1", CanFrame::Data(0x182, {0x01}), T(299ms));
+  runner_->Frame("can1", CanFrame::Data(0x181, {0x01}), T(301ms));
+  runner_->Frame("can0", Emcy(6, 0x8140), T(300ms));
+  ASSERT_NE(Decided("after"), nullptr);
+  EXPECT_EQ(Decided("after")->verdict.outcome, Outcome::kPassed);
+  EXPECT_EQ(Decided("after")->verdict.time, T(301ms));
+  scheduler_.Advance(100ms);
+  ASSERT_NE(Decided("before"), nullptr);
+  EXPECT_EQ(Decided("before")->verdict.outcome, Outcome::kPassed) << Decided("before")->verdict.detail;
+}
+
 TEST_F(ScenarioRunnerTest, ThroughoutPollsTheWholeWindow) {
   Run(R"(scenario { name: "hold" expect { within_ms: 1000 throughout: true controller { node: "quad-6" state: "error-active" } } })");
   scheduler_.Advance(500ms);
