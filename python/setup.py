@@ -17,7 +17,6 @@ import subprocess
 from pathlib import Path
 
 from setuptools import setup
-from setuptools.command.build_py import build_py
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -62,10 +61,8 @@ def generate() -> None:
     # not, so they are importable as canfleet._proto.canfleet_wire_pb2 as they are.
 
 
-class BuildPyWithProtos(build_py):
-    def run(self) -> None:
-        generate()
-        super().run()
-
-
-setup(cmdclass={"build_py": BuildPyWithProtos})
+# Before setup(), not in build_py: pip asks for the metadata first (egg_info, dist_info,
+# editable_wheel), and setuptools then already wants the package folder canfleet/_proto/. A fresh
+# clone has none (it is generated, not in git): generating only in build_py failed there.
+generate()
+setup()

@@ -9,6 +9,9 @@
 # network.
 #
 # Usage: scripts/python-env.sh          prints the interpreter path (.venv/bin/python)
+# Exit codes: 0 ready; 75 PyPI could not be reached for the pinned packages (callers skip, saying
+# so); 1 anything else, above all the canfleet package failing to build or import (callers fail:
+# that is our bug, not the machine's).
 #
 # The venv is made with Debian's /usr/bin/python3 (package python3-venv), never with another
 # python first on PATH (pyenv shims), so it is the same on every Debian 12 machine.
@@ -74,7 +77,12 @@ if ! installed; then
   "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
     "python-can==$PYTHON_CAN_VERSION" "canopen==$CANOPEN_VERSION" "pytest==$PYTEST_VERSION" \
     "protobuf==$PROTOBUF_VERSION" "setuptools==$SETUPTOOLS_VERSION" "wheel==$WHEEL_VERSION" \
-    "mypy==$MYPY_VERSION" "types-protobuf==$TYPES_PROTOBUF_VERSION" >&2
+    "mypy==$MYPY_VERSION" "types-protobuf==$TYPES_PROTOBUF_VERSION" >&2 || {
+    # Pinned releases from PyPI: what fails here is the network (a machine that cannot reach PyPI),
+    # 75 (EX_TEMPFAIL) so that the suites say "skipped: no venv" rather than fail.
+    echo "python-env: pip could not install the pinned packages (is PyPI reachable?)" >&2
+    exit 75
+  }
   installed || {
     echo "python-env: the pinned versions are not importable after installing" >&2
     exit 1

@@ -10,7 +10,7 @@ import pytest
 
 import canfleet
 from canfleet import Fleet
-from helpers import BROKEN, PAIR, alive, children_of, fleet_pids, wait_until
+from helpers import BROKEN, HERE, PAIR, alive, children_of, fleet_pids, wait_until
 
 pytestmark = pytest.mark.topology("topologies/pair.textproto")
 
@@ -163,8 +163,10 @@ def test_bad_arguments_raise_before_anything_starts(tmp_path: Path) -> None:
 
 
 def test_a_fleet_that_is_not_ready_in_time_raises_with_the_logs_tail(tmp_path: Path) -> None:
+    # Its external node never attaches (a 1 ms timeout on the pair raced a quick start: the fleet was
+    # sometimes ready before the first look, and the test leaked it).
     with pytest.raises(canfleet.FleetStartError) as e:
-        Fleet.up(PAIR, state_dir=tmp_path / "state", ready_timeout=0.001)
+        Fleet.up(HERE / "topologies" / "never-ready.textproto", state_dir=tmp_path / "state", ready_timeout=1)
     assert "not ready within" in str(e.value)
     assert e.value.log == tmp_path / "state" / "orchestrator.log"
     assert "control API on" in str(e.value) or "canfleet" in str(e.value)
