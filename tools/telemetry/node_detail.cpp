@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tools/telemetry/event_format.hpp"
+#include "tools/telemetry/text_fit.hpp"
 
 namespace canfleet::tools {
 
@@ -22,10 +23,9 @@ std::string Printf(const char* format, auto... args) {
   return text;
 }
 
-std::string Fit(std::string line, int width) {
-  if (width > 0 && line.size() > static_cast<std::size_t>(width))
-    line.resize(static_cast<std::size_t>(width));
-  return line;
+/// Lines too long for the screen are cut at a word boundary and end in "...".
+std::string Fit(const std::string& line, int width) {
+  return FitLine(line, width);
 }
 
 std::string Consumers(const NodeStatusSample& s) {
@@ -33,13 +33,15 @@ std::string Consumers(const NodeStatusSample& s) {
   std::string text;
   for (const auto& c : s.heartbeat_consumers)
     text += Printf("%s#%u %s (%u ms, last %s)", text.empty() ? "" : ", ", c.node_id,
-                   telemetry::ToString(c.state), c.time_ms, telemetry::ShortName(c.last_state));
+                   telemetry::ToString(c.state), c.time_ms, telemetry::StateName(c.last_state));
   return text;
 }
 
-/// "AIN1.voltage_mV      1200 mV": the name in `name_width`, the value and unit after it.
+/// "AIN1.voltage_mV      1200 mV", "PS.state  on": the name in `name_width`, then the value with
+/// its unit, or a bool's or an enum's word (IoValue.text: what `canfleet io get` prints).
 std::string IoCell(const telemetry::IoValueSample& v, int name_width) {
-  const std::string value = FormatIoValue(v.value) + (v.unit.empty() ? "" : " " + v.unit);
+  const std::string value =
+      !v.text.empty() ? v.text : FormatIoValue(v.value) + (v.unit.empty() ? "" : " " + v.unit);
   return Printf("%-*.*s %12s", name_width, name_width, v.name.c_str(), value.c_str());
 }
 
@@ -81,18 +83,20 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   }
   const NodeRow& row = it->second;
   const NodeStatusSample& s = row.status;
-  std::string state = row.alive ? telemetry::ShortName(s.nmt_state) : (row.disposed ? "LEFT" : "LOST");
+  std::string state = row.alive ? telemetry::StateName(s.nmt_state) : (row.disposed ? "LEFT" : "LOST");
+  const std::string who_named = s.name.empty() ? who : who + " " + s.name;
   if (IsStale(row, now)) state = "STALE";
 
   top.push_back(paint(kBold, Fit(Printf("canfleet top  %s  %s  %s  (node detail)", FormatTime(now).c_str(),
-                                        who.c_str(), s.device.c_str()),
+                                        who_named.c_str(), s.device.c_str()),
                                  width)));
   top.push_back(
-      Fit(Printf("NMT %s  controller %s  TEC %u  REC %u  error register (1001h) %02Xh  uptime %s  "
-                 "status %s old",
-                 state.c_str(), telemetry::ShortName(s.controller_state), s.tec, s.rec, s.error_register,
-                 FormatUptime(s.uptime).c_str(), FormatAge(now - row.last_sample).c_str()),
+      Fit(Printf("NMT %s  controller %s  TEC %u  REC %u  error register (1001h) %02Xh", state.c_str(),
+                 telemetry::StateName(s.controller_state), s.tec, s.rec, s.error_register),
           width));
+  top.push_back(Fit(Printf("uptime %s  status %s old", FormatUptime(s.uptime).c_str(),
+                           FormatAge(now - row.last_sample).c_str()),
+                    width));
   top.push_back(Fit(Printf("heartbeat: produced every %u ms (1017h); consumed (1016h): %s",
                            s.heartbeat_producer_ms, Consumers(s).c_str()),
                     width));

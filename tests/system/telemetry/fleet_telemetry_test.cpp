@@ -140,10 +140,11 @@ TEST_F(FleetTelemetry, ReaderSeesEveryNodeTheFaultAndTheRecoveryAndLateJoinersSe
   int rows = 0;
   std::istringstream lines(top);
   for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("sys0 ", 0) == 0 && line.find("kbit/s") == std::string::npos) ++rows;
+    // A node row: the marker column, the node's name, its bus (issue 29: the name leads the row).
+    if (line.rfind("  fake-", 0) == 0 && line.find(" sys0 ") != std::string::npos) ++rows;
   }
   EXPECT_EQ(rows, kNodes) << top;
-  EXPECT_NE(top.find("20 nodes on 1 buses, 0 faulted"), std::string::npos) << top;
+  EXPECT_NE(top.find("20 nodes on 1 bus, 0 faulted"), std::string::npos) << top;
 
   // A late canfleet-watch gets the fault history (transient-local events) as JSON lines.
   const std::string watch =
@@ -189,7 +190,7 @@ TEST(SecondTerminal, ToolsWithNoDdsOptionSeeAFleetStartedWithNoneAndSayWhatToDoW
   top.Poll();
   int rows = 0;
   for (const auto& line : top.Lines())
-    if (line.find("st0 ") != std::string::npos && line.find("kbit/s") == std::string::npos) ++rows;
+    if (line.rfind("  ", 0) == 0 && line.find(" st0 ") != std::string::npos) ++rows;
   EXPECT_EQ(rows, 3) << top.Log();
 
   // Where nothing is: the hint names the domain and the configuration it looked with.
@@ -252,7 +253,7 @@ TEST(FleetTelemetryScale, TopShows127NodesOfOneBus) {
   tool.Poll();
   int rows = 0;
   for (const auto& line : tool.Lines()) {
-    if (line.rfind("big0 ", 0) == 0 && line.find("kbit/s") == std::string::npos) ++rows;
+    if (line.rfind("  ", 0) == 0 && line.find(" big0 ") != std::string::npos) ++rows;
   }
   EXPECT_EQ(rows, 127);
 }
