@@ -117,6 +117,8 @@ int RunFleet(const UpOptions& options) {
     fleet_options.wall_origin = host.wall_origin();
     fleet_options.repeat_scenario = true;
     fleet_options.seed = spec.time().seed();
+    fleet_options.scenario_source = options.topology.string();
+    fleet_options.step_lines = loaded.step_lines;
     UseHostTime(fleet_options, host.conductor());
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
@@ -133,6 +135,10 @@ int RunFleet(const UpOptions& options) {
   // Telemetry: the buses' statistics and the fault event log on DDS (the nodes publish their own);
   // the fleet runs without it if DDS fails.
   if (options.telemetry) host.StartTelemetry(options.dds, std::chrono::seconds(1));
+  // The scenario's status and verdicts (issue 29), for `canfleet top`, `canfleet watch` and any reader.
+  std::unique_ptr<broker::ScenarioTelemetry> scenario_telemetry;
+  if (auto* publisher = host.publisher())
+    scenario_telemetry = PublishScenario(*fleet, *publisher, host.scheduler());
   fleet->OnFaultEvent([&](const control::FaultStatus& status, bool started) {
     broker::BrokerTelemetry* bus_telemetry = host.telemetry();
     if (bus_telemetry == nullptr) return;
@@ -175,6 +181,7 @@ int RunFleet(const UpOptions& options) {
     if (!options.no_start) conductor->HoldUntilJoined(NodeProcesses(spec), kJoinTimeout);
   }
   io.run();
+  scenario_telemetry.reset();  // before the fleet, whose hooks call it
   control_server.reset();
   fleet.reset();
   spdlog::info("stopped");
