@@ -114,6 +114,13 @@ void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& me
       early_emcy_.erase(early);
     }
     nodes_.emplace(key, std::move(row));
+    // Events of the node that came before its first status (an EMCY is taken before the status
+    // it changed) get its name now.
+    if (!sample.name.empty()) {
+      for (FleetEvent& e : recent_)
+        if (e.name.empty() && e.kind != EventKind::kVerdict && e.node_id == key.node_id && e.bus == key.bus)
+          e.name = sample.name;
+    }
     last_new_node_ = std::max(last_new_node_, std::chrono::system_clock::now());
     Emit({.time = meta.source_time,
           .kind = EventKind::kNodeSeen,

@@ -8,6 +8,13 @@
 
 namespace canfleet::tools {
 
+namespace {
+
+/// A cuttable part is kept cut only with this much room: less would say nothing but "...".
+constexpr std::size_t kMinCut = 12;
+
+}  // namespace
+
 std::string FitLine(std::string_view text, int width) {
   if (width <= 0 || text.size() <= static_cast<std::size_t>(width)) return std::string(text);
   const std::size_t n = telemetry::CutAtWord(text, static_cast<std::size_t>(width));
@@ -39,7 +46,7 @@ std::vector<Part> FitParts(const std::vector<Part>& parts, int width, std::strin
     const std::size_t sep = count == 0 ? 0 : separator.size();
     if (used + sep + part.text.size() <= limit) {
       kept[i] = part.text;
-    } else if (part.cuttable && used + sep + 8 <= limit) {
+    } else if (part.cuttable && used + sep + kMinCut <= limit) {
       kept[i] = FitLine(part.text, static_cast<int>(limit - used - sep));
     } else {
       continue;

@@ -26,7 +26,7 @@ struct Part {
 
 /// The parts that fit in `width`, in their order, chosen by priority: each part, most important
 /// first, is kept if it fits with the parts already kept (separated by `separator`); a cuttable
-/// one is cut to the room left (if at least 8 characters are). Returns the parts kept (their text
+/// one is cut to the room left (if at least 12 characters are). Returns the parts kept (their text
 /// possibly cut).
 std::vector<Part> FitParts(const std::vector<Part>& parts, int width, std::string_view separator = "  ");
 

@@ -299,7 +299,7 @@ std::vector<Part> ScenarioParts(const ScenarioRow& row, WallTime now) {
   const auto& s = row.status;
   std::vector<Part> parts;
   parts.push_back({"scenario " + (s.scenario.empty() ? s.source : s.scenario), 0, true, kBold});
-  parts.push_back({Printf("cycle %u", s.cycle), 3});
+  parts.push_back({Printf("cycle %u", s.cycle), 4});
   parts.push_back({Printf("t=%.1f s", s.scenario_time_s), 1});
   if (s.time_mode == "virtual") parts.push_back({"virtual", 6});
   parts.push_back({Printf("%u passed", s.passed), 2, false, s.passed > 0 ? kGreen : ""});
@@ -310,8 +310,9 @@ std::vector<Part> ScenarioParts(const ScenarioRow& row, WallTime now) {
   if (IsStale(row, now))
     parts.push_back({"(no news for " + FormatAge(now - row.last_sample) + ")", 1, false, kYellow});
   else if (!s.running && s.cycle > 0)
-    parts.push_back({"done", 4});
-  if (!s.step.empty()) parts.push_back({"step " + s.step, 5, true});
+    parts.push_back({"done", 5});
+  // A step's name is kept whole or left out: half a name says nothing.
+  if (!s.step.empty()) parts.push_back({"step " + s.step, 3});
   return parts;
 }
 

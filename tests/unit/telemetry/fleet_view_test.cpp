@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace canfleet::tools {
 namespace {
 
@@ -262,6 +264,16 @@ TEST(FleetView, NodeEventsCarryTheNodesName) {
   ASSERT_EQ(events.size(), 2u);
   EXPECT_EQ(events[1].kind, EventKind::kEmcy);
   EXPECT_EQ(events[1].name, "quad-6");
+  // An EMCY taken before its node's first status is named once the status arrives.
+  view.Apply(EmcySample{.bus = "can0", .node_id = 7, .emcy = {.code = 0x8130}}, At(kStart + 3s), nullptr);
+  NodeStatusSample seven = Status(7);
+  seven.name = "quad-7";
+  view.Apply(seven, At(kStart + 3s), nullptr);
+  const auto emcy = std::find_if(view.recent().begin(), view.recent().end(), [](const FleetEvent& e) {
+    return e.kind == EventKind::kEmcy && e.node_id == 7;
+  });
+  ASSERT_NE(emcy, view.recent().end());
+  EXPECT_EQ(emcy->name, "quad-7");
 }
 
 TEST(FleetView, AScenarioWithoutNewsIsStale) {

@@ -224,6 +224,32 @@ TEST_F(DemoFleet, TheScenarioLineShowsCycleClockCountsAndStepUnderTheBuses) {
   EXPECT_NE(can0->find("FAULTS #3 bus-off node 34"), std::string::npos) << *can0;  // faults before top ids
 }
 
+TEST_F(DemoFleet, AStepNameIsShownWholeOrNotAtAll) {
+  view_.Apply(telemetry::ScenarioStatusSample{.source = "topologies/demo.textproto",
+                                              .scenario = "demo",
+                                              .scenario_time_s = 51.5,
+                                              .cycle = 2,
+                                              .running = true,
+                                              .passed = 13,
+                                              .pending = 12,
+                                              .step = "psu-34-bus-off-preop",
+                                              .publish_period = 1s},
+              At(kNow - 100ms), nullptr);
+  RenderSettings settings{.width = 80, .height = 40, .color = false, .now = kNow};
+  auto lines = Lines(RenderFrame(view_, settings));
+  auto scenario = std::find_if(lines.begin(), lines.end(),
+                               [](const std::string& l) { return l.rfind("scenario demo", 0) == 0; });
+  ASSERT_NE(scenario, lines.end());
+  EXPECT_EQ(*scenario, "scenario demo  cycle 2  t=51.5 s  13 passed  0 failed  12 pending");
+  settings.width = 100;
+  lines = Lines(RenderFrame(view_, settings));
+  scenario = std::find_if(lines.begin(), lines.end(),
+                          [](const std::string& l) { return l.rfind("scenario demo", 0) == 0; });
+  ASSERT_NE(scenario, lines.end());
+  EXPECT_EQ(*scenario,
+            "scenario demo  cycle 2  t=51.5 s  13 passed  0 failed  12 pending  step psu-34-bus-off-preop");
+}
+
 TEST_F(DemoFleet, VerdictsAreRecentEventsAndFailuresAreRed) {
   RenderSettings settings{.width = 80, .height = 40, .color = false, .event_lines = 10, .now = kNow};
   auto lines = Lines(RenderFrame(view_, settings));
@@ -317,13 +343,15 @@ TEST(TextFit, LinesAreCutAtAWordWithAMarkerCellsWithATilde) {
 
 TEST(TextFit, PartsAreKeptByPriorityInTheirOrder) {
   const std::vector<Part> parts{{"aaaa", 0}, {"bbbbbbbbbb", 2}, {"cc", 1}, {"dd dd dd dd dd", 3, true}};
-  auto kept = FitParts(parts, 14);  // "bbbbbbbbbb" does not fit, nor 8 characters of the cuttable part
+  auto kept = FitParts(parts, 14);  // "bbbbbbbbbb" does not fit, nor 12 characters of the cuttable part
   std::string joined = JoinParts(kept, false);
   EXPECT_EQ(joined, "aaaa  cc");
   kept = FitParts(parts, 40);
   EXPECT_EQ(JoinParts(kept, false), "aaaa  bbbbbbbbbb  cc  dd dd dd dd dd");
-  kept = FitParts(parts, 33);
+  kept = FitParts(parts, 34);
   EXPECT_EQ(JoinParts(kept, false), "aaaa  bbbbbbbbbb  cc  dd dd dd...");
+  kept = FitParts(parts, 31);  // 9 characters left: a cut part would say little more than "..."
+  EXPECT_EQ(JoinParts(kept, false), "aaaa  bbbbbbbbbb  cc");
 }
 
 }  // namespace
