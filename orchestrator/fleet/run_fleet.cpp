@@ -139,6 +139,7 @@ int RunFleet(const UpOptions& options) {
   std::unique_ptr<broker::ScenarioTelemetry> scenario_telemetry;
   if (auto* publisher = host.publisher())
     scenario_telemetry = PublishScenario(*fleet, *publisher, host.scheduler());
+  const auto& topology_nodes = spec.node();
   fleet->OnFaultEvent([&](const control::FaultStatus& status, bool started) {
     broker::BrokerTelemetry* bus_telemetry = host.telemetry();
     if (bus_telemetry == nullptr) return;
@@ -148,6 +149,15 @@ int RunFleet(const UpOptions& options) {
         report.bus = status.spec().bus();
         report.fault_id = status.fault_id();
         report.kind = std::string(control::FaultKindName(status.spec().kind()));
+        // The node it is about, by its node-ID on the fault's bus (monitors show "node 5").
+        for (const auto& node : topology_nodes) {
+          if (node.name() != status.spec().node()) continue;
+          for (int p = 0; p < node.bus_size(); ++p) {
+            const int i = node.node_id_size() == 1 ? 0 : p;
+            if (node.bus(p) == report.bus && i < node.node_id_size() && node.node_id(i) <= 127)
+              report.target_node = static_cast<std::uint8_t>(node.node_id(i));
+          }
+        }
         report.parameters = {{"summary", status.summary()}};
         bus_telemetry->PublishFaultInjected(report);
       } else {

@@ -87,21 +87,24 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   const std::string who_named = s.name.empty() ? who : who + " " + s.name;
   if (IsStale(row, now)) state = "STALE";
 
-  top.push_back(paint(kBold, Fit(Printf("canfleet top  %s  %s  %s  (node detail)", FormatTime(now).c_str(),
-                                        who_named.c_str(), s.device.c_str()),
-                                 width)));
-  top.push_back(
-      Fit(Printf("NMT %s  controller %s  TEC %u  REC %u  error register (1001h) %02Xh", state.c_str(),
-                 telemetry::StateName(s.controller_state), s.tec, s.rec, s.error_register),
-          width));
-  top.push_back(Fit(Printf("uptime %s  status %s old", FormatUptime(s.uptime).c_str(),
-                           FormatAge(now - row.last_sample).c_str()),
+  // The title keeps the node's name and address first; the time goes when the screen is narrow.
+  top.push_back(JoinParts(FitParts({{"canfleet top", 0, false, kBold},
+                                    {who_named, 0, false, kBold},
+                                    {s.device, 1},
+                                    {"(node detail)", 3},
+                                    {FormatTime(now), 2}},
+                                   width),
+                          settings.color));
+  top.push_back(Fit(Printf("NMT %s  controller %s  TEC %u  REC %u", state.c_str(),
+                           telemetry::StateName(s.controller_state), s.tec, s.rec),
                     width));
-  top.push_back(Fit(Printf("heartbeat: produced every %u ms (1017h); consumed (1016h): %s",
-                           s.heartbeat_producer_ms, Consumers(s).c_str()),
+  top.push_back(Fit(Printf("error register (1001h) %02Xh  uptime %s  status %s old", s.error_register,
+                           FormatUptime(s.uptime).c_str(), FormatAge(now - row.last_sample).c_str()),
                     width));
+  top.push_back(Fit(Printf("heartbeat produced every %u ms (1017h)", s.heartbeat_producer_ms), width));
+  top.push_back(Fit("heartbeat consumed (1016h): " + Consumers(s), width));
   top.push_back(Fit(
-      Printf("PDO counters since the node process started: %llu RPDOs received, %llu TPDOs sent",
+      Printf("PDOs since the node process started: %llu received, %llu sent",
              static_cast<unsigned long long>(s.rpdo_count), static_cast<unsigned long long>(s.tpdo_count)),
       width));
   top.push_back("");
@@ -133,8 +136,7 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   top.push_back("");
 
   bottom.push_back(
-      Fit("1003h, the node's error history, is not telemetry: "
-          "`canfleet sdo read NODE 0x1003 1 u32` (sub 0: how many)",
+      Fit("1003h (error history) is not telemetry: canfleet sdo read NODE 0x1003 1 u32 (sub 0: how many)",
           width));
   bottom.push_back(paint(kDim, Fit(help, width)));
 

@@ -216,7 +216,7 @@ TEST_F(NodeDetail, ShowsStatusCountersIoWithUnitsAndTheEmcysTheBusSawNewestFirst
   EXPECT_NE(frame.find("can0 #6  quad-controller"), std::string::npos);
   EXPECT_NE(frame.find("error register (1001h) 01h"), std::string::npos);
   EXPECT_NE(frame.find("#5 timed-out (1500 ms, last operational)"), std::string::npos);
-  EXPECT_NE(frame.find("378 RPDOs received, 1512 TPDOs sent"), std::string::npos);
+  EXPECT_NE(frame.find("378 received, 1512 sent"), std::string::npos);
   EXPECT_NE(frame.find("SIMULATED INPUTS (2)"), std::string::npos);
   EXPECT_NE(frame.find("SIMULATED OUTPUTS (3)"), std::string::npos);
   const auto lines = Lines(frame);
