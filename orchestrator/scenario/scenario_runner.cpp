@@ -335,7 +335,7 @@ void ScenarioRunner::Frame(const std::string& bus, const CanFrame& frame, TimePo
 std::vector<Result> ScenarioRunner::Results() const {
   std::vector<Result> out;
   for (const auto& e : expects_)
-    out.push_back({e->step, e->index, e->name, e->description, e->verdict(), e->opened});
+    out.push_back({e->step, e->name, e->description, e->verdict(), e->opened, e->index});
   return out;
 }
 

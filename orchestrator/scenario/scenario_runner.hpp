@@ -41,11 +41,11 @@ class FleetProbe {
 /// One expectation's result.
 struct Result {
   int step = 0;             ///< index in Topology.scenario
-  int index = 0;            ///< among the scenario's expectations (file order, 0-based)
   std::string name;         ///< the step's name, or "scenario[i]"
   std::string description;  ///< "EMCY 8130h from quad-6 within 1500 ms after cut-hb"
   Verdict verdict;
   std::optional<TimePoint> opened;  ///< when its window opened (unset: never)
+  int index = 0;                    ///< among the scenario's expectations (file order, 0-based)
 };
 
 /// Where a run stands (for monitors: telemetry's ScenarioStatus).
