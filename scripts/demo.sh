@@ -8,8 +8,9 @@
 # What you see: `canfleet up` starts the orchestrator (broker, control API) and one process per
 # node; its log (boot-ups, configuration, EMCYs, the scenario's faults and every expectation's
 # verdict, "expect pass ...") goes to build/demo/orchestrator.log. The terminal shows `canfleet
-# top`: every node's NMT state, controller state, error register, heartbeat consumers, PDO
-# counters and last EMCY as they publish it over DDS, and the bus load; up/down and Enter open a
+# top`: every node by name with its NMT state, controller state, error register, heartbeat
+# consumers and last EMCY as they publish it over DDS, the bus load, the scenario's cycle, clock,
+# verdict counts and step, and its verdicts among the recent events; up/down and Enter open a
 # node's simulated I/O and EMCY history, Esc goes back. The demo topology's scenario moves inputs,
 # then injects and clears a heartbeat loss (40 s), an RPDO timeout (60 s) and a bus-off (80 s)
 # in turn, each followed by expectations of the EMCY, NMT and output reactions; it runs again 10 s
@@ -52,6 +53,6 @@ done
 "$bin/canfleet" status
 echo
 echo "live view (canfleet top; up/down and Enter: a node's I/O and EMCYs); Ctrl-C stops the demo"
-echo "faults at 40 s, 60 s and 80 s after start; verdicts: grep expect build/demo/orchestrator.log"
+echo "faults at 40 s, 60 s and 80 s after start; verdicts in top, canfleet watch --type verdict, or: grep expect build/demo/orchestrator.log"
 sleep 2
 "$bin/canfleet" top || true

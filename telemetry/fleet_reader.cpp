@@ -49,18 +49,24 @@ struct FleetReader::Impl {
         io(participant, std::move(h.io)),
         bus_stats(participant, std::move(h.bus_stats)),
         fault(participant, std::move(h.fault)),
+        verdict(participant, std::move(h.verdict)),
+        scenario(participant, std::move(h.scenario)),
         waitset(participant) {
     if (node_status.reader) waitset.AttachDataAvailable(node_status.reader->handle());
     if (emcy.reader) waitset.AttachDataAvailable(emcy.reader->handle());
     if (io.reader) waitset.AttachDataAvailable(io.reader->handle());
     if (bus_stats.reader) waitset.AttachDataAvailable(bus_stats.reader->handle());
     if (fault.reader) waitset.AttachDataAvailable(fault.reader->handle());
+    if (verdict.reader) waitset.AttachDataAvailable(verdict.reader->handle());
+    if (scenario.reader) waitset.AttachDataAvailable(scenario.reader->handle());
   }
   Subscription<canfleet_telemetry_NodeStatus, NodeStatusSample> node_status;
   Subscription<canfleet_telemetry_Emcy, EmcySample> emcy;
   Subscription<canfleet_telemetry_IoSnapshot, IoSnapshotSample> io;
   Subscription<canfleet_telemetry_BusStats, BusStatsSample> bus_stats;
   Subscription<canfleet_telemetry_FaultEvent, FaultEventSample> fault;
+  Subscription<canfleet_telemetry_Verdict, VerdictSample> verdict;
+  Subscription<canfleet_telemetry_ScenarioStatus, ScenarioStatusSample> scenario;
   WaitSet waitset;  // deleted before the readers' conditions (declared last)
 };
 
@@ -71,8 +77,8 @@ FleetReader::~FleetReader() = default;
 
 std::size_t FleetReader::Poll() {
   // Events first: an EMCY and the status it changed arrive in that order at the handlers.
-  return impl_->emcy.Poll() + impl_->fault.Poll() + impl_->node_status.Poll() + impl_->io.Poll() +
-         impl_->bus_stats.Poll();
+  return impl_->emcy.Poll() + impl_->fault.Poll() + impl_->verdict.Poll() + impl_->node_status.Poll() +
+         impl_->io.Poll() + impl_->bus_stats.Poll() + impl_->scenario.Poll();
 }
 
 bool FleetReader::Wait(std::chrono::nanoseconds timeout) {

@@ -33,6 +33,8 @@ struct FleetHandlers {
   std::function<void(const IoSnapshotSample&, const SampleMeta&)> io{};
   std::function<void(const BusStatsSample&, const SampleMeta&)> bus_stats{};
   std::function<void(const FaultEventSample&, const SampleMeta&)> fault{};
+  std::function<void(const VerdictSample&, const SampleMeta&)> verdict{};
+  std::function<void(const ScenarioStatusSample&, const SampleMeta&)> scenario{};
 };
 
 class FleetReader {

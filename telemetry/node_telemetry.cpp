@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <stdexcept>
 
 #include "telemetry/samples.hpp"
@@ -54,6 +55,7 @@ struct NodeTelemetry::Impl {
     CopyBounded(status.bus, options.bus);
     status.node_id = options.node_id;
     CopyBounded(status.device, options.device);
+    CopyBoundedAtWord(status.name, options.name);
     status.heartbeat_consumers._buffer = consumers.data();
     status.heartbeat_consumers._maximum = static_cast<std::uint32_t>(consumers.size());
     status.heartbeat_consumers._release = false;  // our buffer, not Cyclone's
@@ -170,11 +172,23 @@ struct NodeTelemetry::Impl {
     Count(status_writer.Write(status), state_writes);
   }
 
+  /// A bool's or an enum's word for `value` (the index of the word); "" for a number or an index
+  /// that names no word.
+  static void SetIoValue(canfleet_telemetry_IoValue& out, const IoChannel& channel, double value) {
+    out.value = value;
+    if (channel.words.empty()) return;  // a number: text stays ""
+    const double index = std::round(value);
+    if (index >= 0 && index < static_cast<double>(channel.words.size()))
+      CopyBounded(out.text, channel.words[static_cast<std::size_t>(index)]);
+    else
+      out.text[0] = '\0';
+  }
+
   void WriteIo() {
     for (std::size_t i = 0; i < options.inputs.size(); ++i)
-      io_inputs[i].value = current_io.inputs[i];
+      SetIoValue(io_inputs[i], options.inputs[i], current_io.inputs[i]);
     for (std::size_t i = 0; i < options.outputs.size(); ++i)
-      io_outputs[i].value = current_io.outputs[i];
+      SetIoValue(io_outputs[i], options.outputs[i], current_io.outputs[i]);
     ++io.serial;
     Count(io_writer.Write(io), state_writes);
   }

@@ -45,16 +45,23 @@ struct NodeStatusSnapshot {
 /// move with every PDO and go out with the periodic publication.
 bool StatusChanged(const NodeStatusSnapshot& a, const NodeStatusSnapshot& b);
 
-/// A simulated input or output: name (e.g. "AIN1.voltage_V") and unit (e.g. "V").
+/// A simulated input or output: name (e.g. "AIN1.voltage_V") and unit (e.g. "V"). A bool or an
+/// enum has its words by value: {"false", "true"}, or the enum's choices in order; its value is
+/// the index of the word, and IoValue.text carries the word (copied by the publisher, no
+/// allocation).
 struct IoChannel {
   std::string name;
   std::string unit;
+  std::vector<std::string> words{};
 };
 
 struct NodeTelemetryOptions {
   std::string bus{};  ///< at most kMaxBusName characters
   std::uint8_t node_id = 0;
   std::string device = "generic";
+  /// The node's name in its topology (canfleet-node --name); at most kMaxNodeName characters
+  /// are published.
+  std::string name{};
   /// Every instance is republished at least this often (uptime, counters, liveliness for readers).
   std::chrono::milliseconds period{1000};
   /// Snapshots are sampled at most this often; changes in between are coalesced (latest wins).

@@ -16,6 +16,18 @@ bool BusStatsChanged(const BusStatsSnapshot& a, const BusStatsSnapshot& b) {
          a.error_frames != b.error_frames;
 }
 
+bool ScenarioStatusChanged(const ScenarioStatusSnapshot& a, const ScenarioStatusSnapshot& b) {
+  return a.scenario != b.scenario || a.time_mode != b.time_mode || a.cycle != b.cycle ||
+         a.running != b.running || a.expectations != b.expectations || a.passed != b.passed ||
+         a.failed != b.failed || a.skipped != b.skipped || a.pending != b.pending || a.step != b.step ||
+         a.step_time_s != b.step_time_s;
+}
+
+std::string SourceKey(const std::string& source) {
+  if (source.size() <= kMaxScenarioSource) return source;
+  return std::string(kCutMarker) + source.substr(source.size() - (kMaxScenarioSource - kCutMarker.size()));
+}
+
 namespace {
 
 void CheckBusName(const std::string& bus) {
@@ -36,6 +48,17 @@ struct BusState {
   std::uint32_t serial = 0;
 };
 
+/// Publisher-thread state of one scenario.
+struct ScenarioState {
+  ScenarioStatusSnapshot current;
+  ScenarioStatusSnapshot published;
+  bool change = true;
+  bool removed = false;
+  TimePoint written{};
+  TimePoint due{};
+  std::uint32_t serial = 0;
+};
+
 }  // namespace
 
 struct OrchestratorTelemetry::Impl {
@@ -44,7 +67,11 @@ struct OrchestratorTelemetry::Impl {
         stats_topic(participant),
         fault_topic(participant),
         stats_writer(participant, stats_topic),
-        fault_writer(participant, fault_topic) {
+        fault_writer(participant, fault_topic),
+        verdict_topic(participant),
+        scenario_topic(participant),
+        verdict_writer(participant, verdict_topic),
+        scenario_writer(participant, scenario_topic) {
     stats_sample.top_cob_ids = {static_cast<std::uint32_t>(cob_ids.size()), 0, cob_ids.data(), false};
     fault_sample.parameters = {static_cast<std::uint32_t>(parameters.size()), 0, parameters.data(), false};
   }
@@ -54,16 +81,28 @@ struct OrchestratorTelemetry::Impl {
   Topic<canfleet_telemetry_FaultEvent> fault_topic;
   Writer<canfleet_telemetry_BusStats> stats_writer;
   Writer<canfleet_telemetry_FaultEvent> fault_writer;
+  Topic<canfleet_telemetry_Verdict> verdict_topic;
+  Topic<canfleet_telemetry_ScenarioStatus> scenario_topic;
+  Writer<canfleet_telemetry_Verdict> verdict_writer;
+  Writer<canfleet_telemetry_ScenarioStatus> scenario_writer;
 
   // Guarded by PublisherLoop::mutex().
   std::map<std::string, BusStatsSnapshot, std::less<>> pending;
   std::vector<std::string> pending_removals;
   std::deque<FaultSnapshot> faults;
+  std::deque<VerdictSnapshot> verdicts;
+  std::map<std::string, ScenarioStatusSnapshot, std::less<>> pending_scenarios;
+  std::vector<std::string> pending_scenario_removals;
 
   // Publisher thread.
   std::map<std::string, BusState, std::less<>> buses;
   std::vector<FaultSnapshot> fault_batch;
+  std::vector<VerdictSnapshot> verdict_batch;
   std::map<std::string, std::uint32_t, std::less<>> fault_serials;
+  std::map<std::string, std::uint32_t, std::less<>> verdict_serials;
+  std::map<std::string, ScenarioState, std::less<>> scenarios;
+  canfleet_telemetry_Verdict verdict_sample{};
+  canfleet_telemetry_ScenarioStatus scenario_sample{};
   canfleet_telemetry_BusStats stats_sample{};
   std::array<canfleet_telemetry_CobIdRate, kMaxTopCobIds> cob_ids{};
   canfleet_telemetry_FaultEvent fault_sample{};
@@ -107,12 +146,47 @@ struct OrchestratorTelemetry::Impl {
     const std::size_t n = std::min(f.parameters.size(), kMaxFaultParameters);
     for (std::size_t i = 0; i < n; ++i) {
       CopyBounded(parameters[i].name, f.parameters[i].first);
-      CopyBounded(parameters[i].value, f.parameters[i].second);
+      CopyBoundedAtWord(parameters[i].value, f.parameters[i].second);
     }
     fault_sample.parameters._length = static_cast<std::uint32_t>(n);
     fault_sample.bus_time_ns = static_cast<std::uint64_t>(f.bus_time.count());
     fault_sample.serial = ++fault_serials[f.bus];
     Count(fault_writer.Write(fault_sample), event_writes);
+  }
+
+  void WriteVerdict(const VerdictSnapshot& v) {
+    const std::string key = SourceKey(v.source);
+    CopyBounded(verdict_sample.source, key);
+    verdict_sample.index = v.index;
+    CopyBoundedAtWord(verdict_sample.scenario, v.scenario);
+    verdict_sample.cycle = v.cycle;
+    verdict_sample.result = ToDds(v.result);
+    CopyBoundedAtWord(verdict_sample.name, v.name);
+    verdict_sample.line = v.line;
+    verdict_sample.text_cut = CopyBoundedAtWord(verdict_sample.text, v.text);
+    verdict_sample.scenario_time_s = v.scenario_time_s;
+    verdict_sample.serial = ++verdict_serials[key];
+    Count(verdict_writer.Write(verdict_sample), event_writes);
+  }
+
+  void WriteScenario(const std::string& key, ScenarioState& state) {
+    const ScenarioStatusSnapshot& s = state.current;
+    CopyBounded(scenario_sample.source, key);
+    CopyBoundedAtWord(scenario_sample.scenario, s.scenario);
+    CopyBounded(scenario_sample.time_mode, s.time_mode);
+    scenario_sample.scenario_time_s = s.scenario_time_s;
+    scenario_sample.cycle = s.cycle;
+    scenario_sample.running = s.running;
+    scenario_sample.expectations = s.expectations;
+    scenario_sample.passed = s.passed;
+    scenario_sample.failed = s.failed;
+    scenario_sample.skipped = s.skipped;
+    scenario_sample.pending = s.pending;
+    CopyBoundedAtWord(scenario_sample.step, s.step);
+    scenario_sample.step_time_s = s.step_time_s;
+    scenario_sample.publish_period_ms = static_cast<std::uint32_t>(options.period.count());
+    scenario_sample.serial = ++state.serial;
+    Count(scenario_writer.Write(scenario_sample), state_writes);
   }
 };
 
@@ -180,6 +254,43 @@ void OrchestratorTelemetry::PublishFault(FaultSnapshot fault) {
   if (notify) Notify();
 }
 
+void OrchestratorTelemetry::PublishVerdict(VerdictSnapshot verdict) {
+  bool notify = false;
+  {
+    const std::lock_guard lock(mutex());
+    if (impl_->faults.size() + impl_->verdicts.size() >= impl_->options.fault_queue) {
+      impl_->events_dropped.fetch_add(1, std::memory_order_relaxed);
+    } else {
+      impl_->verdicts.push_back(std::move(verdict));
+      notify = MarkEventLocked();
+    }
+  }
+  if (notify) Notify();
+}
+
+void OrchestratorTelemetry::UpdateScenario(const ScenarioStatusSnapshot& status) {
+  const std::string key = SourceKey(status.source);
+  bool notify;
+  {
+    const std::lock_guard lock(mutex());
+    impl_->pending_scenarios[key] = status;
+    notify = MarkInputLocked();
+  }
+  if (notify) Notify();
+}
+
+void OrchestratorTelemetry::RemoveScenario(const std::string& source) {
+  const std::string key = SourceKey(source);
+  bool notify;
+  {
+    const std::lock_guard lock(mutex());
+    impl_->pending_scenarios.erase(key);
+    impl_->pending_scenario_removals.push_back(key);
+    notify = MarkEventLocked();
+  }
+  if (notify) Notify();
+}
+
 PublisherStats OrchestratorTelemetry::stats() const {
   return {impl_->state_writes.load(), impl_->event_writes.load(), impl_->write_errors.load(),
           impl_->events_dropped.load()};
@@ -191,11 +302,31 @@ void OrchestratorTelemetry::ConsumeLocked(bool inputs) {
     m.fault_batch.push_back(std::move(m.faults.front()));
     m.faults.pop_front();
   }
+  // A verdict's scenario status (handed over just before it) goes out with it, not after the
+  // sampling window: a reader sees the counts that include the verdict.
+  const bool verdicts = !m.verdicts.empty();
+  while (!m.verdicts.empty()) {
+    m.verdict_batch.push_back(std::move(m.verdicts.front()));
+    m.verdicts.pop_front();
+  }
   for (const std::string& bus : m.pending_removals) {
     auto it = m.buses.find(bus);
     if (it != m.buses.end()) it->second.removed = true;
   }
   m.pending_removals.clear();
+  for (const std::string& source : m.pending_scenario_removals) {
+    auto it = m.scenarios.find(source);
+    if (it != m.scenarios.end()) it->second.removed = true;
+  }
+  m.pending_scenario_removals.clear();
+  if (inputs || verdicts) {
+    for (auto& [source, snapshot] : m.pending_scenarios) {
+      ScenarioState& scenario = m.scenarios[source];
+      scenario.current = snapshot;
+      scenario.removed = false;
+    }
+    m.pending_scenarios.clear();
+  }
   if (!inputs) return;
   for (auto& [name, snapshot] : m.pending) {
     BusState& bus = m.buses[name];
@@ -210,8 +341,34 @@ TimePoint OrchestratorTelemetry::Publish(TimePoint now, bool force) {
   for (const FaultSnapshot& f : m.fault_batch)
     m.WriteFault(f);
   m.fault_batch.clear();
-
+  // The scenario's status before its verdicts: a reader that shows a verdict finds its cycle.
   TimePoint next = now + m.options.period;
+  for (auto it = m.scenarios.begin(); it != m.scenarios.end();) {
+    ScenarioState& scenario = it->second;
+    if (scenario.removed) {
+      canfleet_telemetry_ScenarioStatus key{};
+      CopyBounded(key.source, it->first);
+      m.scenario_writer.Dispose(key);
+      it = m.scenarios.erase(it);
+      continue;
+    }
+    scenario.change = scenario.change || ScenarioStatusChanged(scenario.current, scenario.published);
+    if (now >= scenario.due || (scenario.change && (force || now >= scenario.written + min_interval() ||
+                                                    !m.verdict_batch.empty()))) {
+      m.WriteScenario(it->first, scenario);
+      scenario.published = scenario.current;
+      scenario.change = false;
+      scenario.written = now;
+      scenario.due = now + m.options.period;
+    }
+    next = std::min(next, scenario.due);
+    if (scenario.change) next = std::min(next, scenario.written + min_interval());
+    ++it;
+  }
+  for (const VerdictSnapshot& v : m.verdict_batch)
+    m.WriteVerdict(v);
+  m.verdict_batch.clear();
+
   for (auto it = m.buses.begin(); it != m.buses.end();) {
     BusState& bus = it->second;
     if (bus.removed) {

@@ -1,7 +1,7 @@
 #pragma once
-/// @file What the orchestrator publishes: BusStats per bus (on change and every period) and
-/// FaultEvent events. Same threading as NodeTelemetry (publisher_loop.hpp): callers copy, one
-/// thread writes.
+/// @file What the orchestrator publishes: BusStats per bus and ScenarioStatus per scenario (on
+/// change and every period), FaultEvent and Verdict events. Same threading as NodeTelemetry
+/// (publisher_loop.hpp): callers copy, one thread writes.
 ///
 /// @code
 ///   telemetry::OrchestratorTelemetry telemetry(participant);
@@ -58,6 +58,44 @@ struct FaultSnapshot {
   BusTime bus_time{};
 };
 
+/// One decided expectation. Verdicts are rare: this one may allocate.
+struct VerdictSnapshot {
+  std::string source{};     ///< the topology file as given; a longer one than 127 keeps its end
+  std::uint16_t index = 0;  ///< among the file's expectations; kFileVerdictIndex: the file itself
+  std::string scenario{};
+  std::uint32_t cycle = 1;
+  VerdictResult result = VerdictResult::kPass;
+  std::string name{};
+  std::uint32_t line = 0;
+  std::string text{};  ///< the whole result line; published cut at a word boundary beyond 1023
+  double scenario_time_s = 0;
+};
+
+/// Where a scenario stands (keyed by source). Written at once when anything but the clock changed,
+/// and every period.
+struct ScenarioStatusSnapshot {
+  std::string source{};
+  std::string scenario{};
+  std::string time_mode{};  ///< "real" or "virtual"
+  double scenario_time_s = 0;
+  std::uint32_t cycle = 0;
+  bool running = false;
+  std::uint16_t expectations = 0;
+  std::uint16_t passed = 0;
+  std::uint16_t failed = 0;
+  std::uint16_t skipped = 0;
+  std::uint16_t pending = 0;
+  std::string step{};
+  double step_time_s = 0;
+};
+
+/// True if anything but the scenario clock changed: that goes out at once.
+bool ScenarioStatusChanged(const ScenarioStatusSnapshot& a, const ScenarioStatusSnapshot& b);
+
+/// The key a scenario's source is published under: itself when it fits Verdict.source
+/// (string<127>), else "..." and its last characters (the file name survives).
+std::string SourceKey(const std::string& source);
+
 struct OrchestratorTelemetryOptions {
   std::chrono::milliseconds period{1000};
   std::chrono::milliseconds min_interval{20};
@@ -81,8 +119,15 @@ class OrchestratorTelemetry final : private PublisherLoop {
   void UpdateBusStats(const BusStatsSnapshot& stats);
   /// Disposes a bus's BusStats instance (the bus was removed).
   void RemoveBus(const std::string& bus);
-  /// Queues a fault event for immediate publication.
+  /// Queues a fault event for immediate publication. A parameter value longer than 255 characters
+  /// is cut at a word boundary and ends in "..." (FaultParameter.value).
   void PublishFault(FaultSnapshot fault);
+  /// Queues a verdict for immediate publication (the same queue as faults).
+  void PublishVerdict(VerdictSnapshot verdict);
+  /// Hands over where a scenario stands (keyed by status.source). Any thread; never blocks on DDS.
+  void UpdateScenario(const ScenarioStatusSnapshot& status);
+  /// Disposes a scenario's ScenarioStatus (its fleet stopped).
+  void RemoveScenario(const std::string& source);
 
   using PublisherLoop::Flush;
   PublisherStats stats() const;

@@ -20,31 +20,39 @@ const char* ToString(FaultAction action) {
   return action == FaultAction::kInjected ? "injected" : "cleared";
 }
 
-const char* ShortName(std::optional<NmtState> state) {
-  if (!state) return "?";
-  switch (*state) {
-    case NmtState::kInitialising:
-      return "INIT";
-    case NmtState::kStopped:
-      return "STOP";
-    case NmtState::kOperational:
-      return "OPER";
-    case NmtState::kPreOperational:
-      return "PREOP";
+const char* ToString(VerdictResult result) {
+  switch (result) {
+    case VerdictResult::kPass:
+      return "pass";
+    case VerdictResult::kFail:
+      return "FAIL";
+    case VerdictResult::kSkip:
+      return "skip";
+    case VerdictResult::kError:
+      return "error";
   }
   return "?";
 }
 
-const char* ShortName(ControllerState state) {
-  switch (state) {
-    case ControllerState::kErrorActive:
-      return "active";
-    case ControllerState::kErrorPassive:
-      return "passive";
-    case ControllerState::kBusOff:
-      return "bus-off";
-  }
-  return "?";
+const char* StateName(std::optional<NmtState> state) {
+  return state ? canopen::ToString(*state) : "unknown";
+}
+
+const char* StateName(ControllerState state) {
+  return canfleet::ToString(state);
+}
+
+std::size_t CutAtWord(std::string_view text, std::size_t max) {
+  if (text.size() <= max) return text.size();
+  if (max <= kCutMarker.size()) return 0;
+  const std::size_t room = max - kCutMarker.size();
+  // The last space at or before `room` (a cut right before a space keeps the word whole).
+  std::size_t cut = room;
+  while (cut > 0 && text[cut] != ' ')
+    --cut;
+  while (cut > 0 && text[cut - 1] == ' ')  // no trailing blanks before the marker
+    --cut;
+  return cut == 0 ? room : cut;  // one word longer than the room: cut it (the marker says so)
 }
 
 canfleet_telemetry_NmtState ToDds(std::optional<NmtState> state) {
@@ -135,6 +143,34 @@ FaultAction FromDds(canfleet_telemetry_FaultAction action) {
   return action == canfleet_telemetry_FAULT_CLEARED ? FaultAction::kCleared : FaultAction::kInjected;
 }
 
+canfleet_telemetry_VerdictResult ToDds(VerdictResult result) {
+  switch (result) {
+    case VerdictResult::kPass:
+      return canfleet_telemetry_VERDICT_PASS;
+    case VerdictResult::kFail:
+      return canfleet_telemetry_VERDICT_FAIL;
+    case VerdictResult::kSkip:
+      return canfleet_telemetry_VERDICT_SKIP;
+    case VerdictResult::kError:
+      return canfleet_telemetry_VERDICT_ERROR;
+  }
+  return canfleet_telemetry_VERDICT_ERROR;
+}
+
+VerdictResult FromDds(canfleet_telemetry_VerdictResult result) {
+  switch (result) {
+    case canfleet_telemetry_VERDICT_PASS:
+      return VerdictResult::kPass;
+    case canfleet_telemetry_VERDICT_FAIL:
+      return VerdictResult::kFail;
+    case canfleet_telemetry_VERDICT_SKIP:
+      return VerdictResult::kSkip;
+    case canfleet_telemetry_VERDICT_ERROR:
+      return VerdictResult::kError;
+  }
+  return VerdictResult::kError;  // an unknown value from a hostile or newer writer
+}
+
 namespace {
 
 // A sequence's _length is trusted only up to its IDL bound (Cyclone checks it on receipt; this
@@ -156,7 +192,7 @@ EmcyInfo ToEmcyInfo(std::uint16_t code, std::uint8_t error_register, const std::
 }
 
 IoValueSample FromDds(const canfleet_telemetry_IoValue& value) {
-  return {FromBounded(value.name), value.value, FromBounded(value.unit)};
+  return {FromBounded(value.name), value.value, FromBounded(value.unit), FromBounded(value.text)};
 }
 
 }  // namespace
@@ -166,6 +202,7 @@ NodeStatusSample FromDds(const canfleet_telemetry_NodeStatus& s) {
   out.bus = FromBounded(s.bus);
   out.node_id = s.node_id;
   out.device = FromBounded(s.device);
+  out.name = FromBounded(s.name);
   out.nmt_state = FromDds(s.nmt_state);
   out.error_register = s.error_register;
   out.controller_state = FromDds(s.controller_state);
@@ -240,6 +277,42 @@ FaultEventSample FromDds(const canfleet_telemetry_FaultEvent& s) {
                                 FromBounded(s.parameters._buffer[i].value));
   }
   out.bus_time = BusTime(static_cast<BusTime::rep>(s.bus_time_ns));
+  out.serial = s.serial;
+  return out;
+}
+
+VerdictSample FromDds(const canfleet_telemetry_Verdict& s) {
+  VerdictSample out;
+  out.source = FromBounded(s.source);
+  out.index = s.index;
+  out.scenario = FromBounded(s.scenario);
+  out.cycle = s.cycle;
+  out.result = FromDds(s.result);
+  out.name = FromBounded(s.name);
+  out.line = s.line;
+  out.text = FromBounded(s.text);
+  out.text_cut = s.text_cut;
+  out.scenario_time_s = s.scenario_time_s;
+  out.serial = s.serial;
+  return out;
+}
+
+ScenarioStatusSample FromDds(const canfleet_telemetry_ScenarioStatus& s) {
+  ScenarioStatusSample out;
+  out.source = FromBounded(s.source);
+  out.scenario = FromBounded(s.scenario);
+  out.time_mode = FromBounded(s.time_mode);
+  out.scenario_time_s = s.scenario_time_s;
+  out.cycle = s.cycle;
+  out.running = s.running;
+  out.expectations = s.expectations;
+  out.passed = s.passed;
+  out.failed = s.failed;
+  out.skipped = s.skipped;
+  out.pending = s.pending;
+  out.step = FromBounded(s.step);
+  out.step_time_s = s.step_time_s;
+  out.publish_period = std::chrono::milliseconds(s.publish_period_ms);
   out.serial = s.serial;
   return out;
 }

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Reader-side C++ values of the five topics, converted from the idlc-generated C samples.
+/// @file Reader-side C++ values of the seven topics, converted from the idlc-generated C samples.
 /// Tools and tests work on these; only telemetry/ touches the C types.
 
 #include <chrono>
@@ -27,6 +27,7 @@ struct NodeStatusSample {
   std::string bus{};
   std::uint8_t node_id = 0;
   std::string device{};
+  std::string name{};                   ///< the node's topology name ("" if it has none)
   std::optional<NmtState> nmt_state{};  ///< nullopt: unknown
   std::uint8_t error_register = 0;
   ControllerState controller_state = ControllerState::kErrorActive;
@@ -55,6 +56,7 @@ struct IoValueSample {
   std::string name{};
   double value = 0;
   std::string unit{};
+  std::string text{};  ///< a bool's or an enum's word ("true", "on"); "" for a number
   friend bool operator==(const IoValueSample&, const IoValueSample&) = default;
 };
 
@@ -92,11 +94,47 @@ struct FaultEventSample {
   std::uint32_t serial = 0;
 };
 
+/// One decided expectation (the Verdict topic).
+struct VerdictSample {
+  std::string source{};  ///< the topology file
+  std::uint16_t index = 0;
+  std::string scenario{};
+  std::uint32_t cycle = 0;
+  VerdictResult result = VerdictResult::kPass;
+  std::string name{};
+  std::uint32_t line = 0;
+  std::string text{};  ///< the result line as `canfleet test` prints it
+  bool text_cut = false;
+  double scenario_time_s = 0;
+  std::uint32_t serial = 0;
+};
+
+/// Where a scenario stands (the ScenarioStatus topic).
+struct ScenarioStatusSample {
+  std::string source{};
+  std::string scenario{};
+  std::string time_mode{};
+  double scenario_time_s = 0;
+  std::uint32_t cycle = 0;
+  bool running = false;
+  std::uint16_t expectations = 0;
+  std::uint16_t passed = 0;
+  std::uint16_t failed = 0;
+  std::uint16_t skipped = 0;
+  std::uint16_t pending = 0;
+  std::string step{};
+  double step_time_s = 0;
+  std::chrono::milliseconds publish_period{};
+  std::uint32_t serial = 0;
+};
+
 NodeStatusSample FromDds(const canfleet_telemetry_NodeStatus& sample);
 EmcySample FromDds(const canfleet_telemetry_Emcy& sample);
 IoSnapshotSample FromDds(const canfleet_telemetry_IoSnapshot& sample);
 BusStatsSample FromDds(const canfleet_telemetry_BusStats& sample);
 FaultEventSample FromDds(const canfleet_telemetry_FaultEvent& sample);
+VerdictSample FromDds(const canfleet_telemetry_Verdict& sample);
+ScenarioStatusSample FromDds(const canfleet_telemetry_ScenarioStatus& sample);
 
 // Enum mappings between our types and the IDL's.
 canfleet_telemetry_NmtState ToDds(std::optional<NmtState> state);
@@ -107,6 +145,8 @@ canfleet_telemetry_HeartbeatConsumerState ToDds(HeartbeatConsumerState state);
 HeartbeatConsumerState FromDds(canfleet_telemetry_HeartbeatConsumerState state);
 canfleet_telemetry_FaultAction ToDds(FaultAction action);
 FaultAction FromDds(canfleet_telemetry_FaultAction action);
+canfleet_telemetry_VerdictResult ToDds(VerdictResult result);
+VerdictResult FromDds(canfleet_telemetry_VerdictResult result);
 
 /// Copies `text` into a bounded IDL string (char[N]), truncating to N-1 characters.
 template <std::size_t N>
@@ -114,6 +154,21 @@ void CopyBounded(char (&out)[N], std::string_view text) {
   const std::size_t n = text.size() < N - 1 ? text.size() : N - 1;
   text.copy(out, n);
   out[n] = '\0';
+}
+
+/// Copies `text` into a bounded IDL string, cut at a word boundary with kCutMarker when it does
+/// not fit (CutAtWord), never mid-word silently. Does not allocate. Returns whether it was cut.
+template <std::size_t N>
+bool CopyBoundedAtWord(char (&out)[N], std::string_view text) {
+  const std::size_t n = CutAtWord(text, N - 1);
+  text.copy(out, n);
+  if (n == text.size()) {
+    out[n] = '\0';
+    return false;
+  }
+  kCutMarker.copy(out + n, kCutMarker.size());
+  out[n + kCutMarker.size()] = '\0';
+  return true;
 }
 
 /// Reads a bounded IDL string; never reads past the array even if it is not terminated.

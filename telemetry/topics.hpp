@@ -1,5 +1,5 @@
 #pragma once
-/// @file The five fleet topics: names, descriptors and QoS profiles (reasons in telemetry/QOS.md).
+/// @file The seven fleet topics: names, descriptors and QoS profiles (reasons in telemetry/QOS.md).
 
 #include <cstdint>
 
@@ -59,6 +59,24 @@ struct TopicTraits<canfleet_telemetry_FaultEvent> {
   static const dds_topic_descriptor_t& Descriptor() { return canfleet_telemetry_FaultEvent_desc; }
   static QosPtr Qos() { return EventQos(); }
   static QosPtr ReaderQos() { return EventReaderQos(); }
+};
+
+/// A verdict is an event, but keyed by (source, index) with keep-last 1: a late joiner gets the
+/// latest verdict of every expectation, not every cycle's (telemetry/QOS.md).
+template <>
+struct TopicTraits<canfleet_telemetry_Verdict> {
+  static constexpr const char* kName = "canfleet_Verdict";
+  static const dds_topic_descriptor_t& Descriptor() { return canfleet_telemetry_Verdict_desc; }
+  static QosPtr Qos() { return StateQos(); }
+  static QosPtr ReaderQos() { return StateReaderQos(); }
+};
+
+template <>
+struct TopicTraits<canfleet_telemetry_ScenarioStatus> {
+  static constexpr const char* kName = "canfleet_ScenarioStatus";
+  static const dds_topic_descriptor_t& Descriptor() { return canfleet_telemetry_ScenarioStatus_desc; }
+  static QosPtr Qos() { return StateQos(); }
+  static QosPtr ReaderQos() { return StateReaderQos(); }
 };
 
 }  // namespace canfleet::telemetry

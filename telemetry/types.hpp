@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 
 #include "bus/bus_port.hpp"
 #include "vocabulary/nmt_state.hpp"
@@ -24,6 +25,15 @@ inline constexpr std::size_t kMaxHeartbeatConsumers = 127;
 inline constexpr std::size_t kMaxIoChannels = 64;
 inline constexpr std::size_t kMaxTopCobIds = 16;
 inline constexpr std::size_t kMaxFaultParameters = 8;
+/// Longest node name (NodeStatus.name, string<31>), I/O word (IoValue.text), fault parameter value
+/// (FaultParameter.value), verdict line (Verdict.text) and scenario file (Verdict.source).
+inline constexpr std::size_t kMaxNodeName = 31;
+inline constexpr std::size_t kMaxIoText = 31;
+inline constexpr std::size_t kMaxFaultValue = 255;
+inline constexpr std::size_t kMaxVerdictText = 1023;
+inline constexpr std::size_t kMaxScenarioSource = 127;
+/// Verdict.index of the verdict about the file itself (its fleet did not start).
+inline constexpr std::uint16_t kFileVerdictIndex = 0xFFFF;
 
 /// State of one heartbeat consumer entry (CiA 301 §7.2.8.3.2): unknown until the first heartbeat.
 enum class HeartbeatConsumerState : std::uint8_t { kUnknown, kActive, kTimedOut };
@@ -49,6 +59,9 @@ struct EmcyInfo {
 
 enum class FaultAction : std::uint8_t { kInjected, kCleared };
 
+/// The result of a decided expectation (Verdict.result).
+enum class VerdictResult : std::uint8_t { kPass, kFail, kSkip, kError };
+
 struct CobIdRate {
   std::uint32_t cob_id = 0;
   float frames_per_second = 0;
@@ -58,9 +71,21 @@ struct CobIdRate {
 
 const char* ToString(HeartbeatConsumerState state);
 const char* ToString(FaultAction action);
-/// Short NMT state names for tables: "INIT", "PREOP", "OPER", "STOP", "?" (nullopt).
-const char* ShortName(std::optional<NmtState> state);
-/// Short controller names: "active", "passive", "bus-off".
-const char* ShortName(ControllerState state);
+/// "pass", "FAIL", "skip", "error": the words `canfleet test` starts its result lines with.
+const char* ToString(VerdictResult result);
+
+/// The NMT state as the CLI (`canfleet status`) and expectations write it: "initialising",
+/// "stopped", "operational", "pre-operational" (vocabulary/nmt_state.hpp); "unknown" (nullopt).
+const char* StateName(std::optional<NmtState> state);
+/// The controller state as the CLI and expectations write it: "error-active", "error-passive",
+/// "bus-off" (bus/bus_port.hpp).
+const char* StateName(ControllerState state);
+
+/// Where `text` is cut to fit `max` characters: at the last space at or before max - 3 (then
+/// "..." follows), so that no word is cut; mid-word only when the first word alone is longer.
+/// Returns text.size() when it fits.
+std::size_t CutAtWord(std::string_view text, std::size_t max);
+/// The marker a text cut by CutAtWord ends in.
+inline constexpr std::string_view kCutMarker = "...";
 
 }  // namespace canfleet::telemetry

@@ -173,7 +173,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
         ports[p]->SetBitRate(*kbit * 1000);
     }
   }
-  if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options));
+  if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options), options.name);
   // Remote I/O: the orchestrator sets and reads the simulated I/O over the broker connection.
   for (std::size_t p = 0; p < port_count; ++p) {
     auto* client = dynamic_cast<BrokerClientPort*>(ports[p].get());

@@ -73,6 +73,7 @@ struct NodeTelemetryWiring::Impl {
   explicit Impl(const TelemetrySettings& s) : settings(s), participant(s.dds) {}
 
   TelemetrySettings settings;
+  std::string name;                    ///< --name: NodeStatus.name
   telemetry::Participant participant;  // declared first: outlives the publishers
   devices::DeviceNode* node = nullptr;
   const Scheduler* scheduler = nullptr;  ///< the node's: the uptime follows its time (virtual too)
@@ -89,6 +90,7 @@ struct NodeTelemetryWiring::Impl {
     return {.bus = port.bus,
             .node_id = port.node_id,
             .device = std::string(node->device().Name()),
+            .name = name,
             .period = settings.period,
             .min_interval = std::chrono::milliseconds(20),
             .inputs = input_channels,
@@ -107,8 +109,14 @@ struct NodeTelemetryWiring::Impl {
         continue;
       }
       io_index[signal.get()] = {input, values.size()};
-      channels.push_back(
-          {signal->name(), signal->kind() == devices::IoKind::kNumber ? signal->spec().unit : ""});
+      // A bool's or an enum's value is the index of its word (IoSignal::Number): the publisher
+      // copies the word into IoValue.text, what `canfleet io get` prints.
+      std::vector<std::string> words;
+      if (signal->kind() == devices::IoKind::kBool) words = {"false", "true"};
+      if (signal->kind() == devices::IoKind::kEnum) words = signal->spec().choices;
+      channels.push_back({signal->name(),
+                          signal->kind() == devices::IoKind::kNumber ? signal->spec().unit : "",
+                          std::move(words)});
       values.push_back(signal->Number());
     }
   }
@@ -203,7 +211,7 @@ canopen::StackHooks NodeTelemetryWiring::Hooks() {
 }
 
 void NodeTelemetryWiring::Attach(devices::DeviceNode& node, Scheduler& scheduler,
-                                 const std::vector<std::string>& buses) {
+                                 const std::vector<std::string>& buses, const std::string& name) {
   Impl& m = *impl_;
   if (m.node) throw std::logic_error("NodeTelemetryWiring::Attach called twice");
   if (buses.size() != node.PortCount()) {
@@ -220,6 +228,7 @@ void NodeTelemetryWiring::Attach(devices::DeviceNode& node, Scheduler& scheduler
   }
   m.node = &node;
   m.scheduler = &scheduler;
+  m.name = name;
   m.CollectIo();
   for (std::size_t p = 0; p < buses.size(); ++p) {
     Impl::Port port;

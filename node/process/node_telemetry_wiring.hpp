@@ -1,13 +1,15 @@
 #pragma once
 /// @file canfleet-node's telemetry (issue 7): the DeviceNode's state published over DDS through
 /// telemetry::NodeTelemetry, one publisher per CAN port (keyed by that port's bus and node-ID):
-///  - NodeStatus: NMT state, 1001h, controller state with TEC/REC, 1017h, the 1016h consumers and
+///  - NodeStatus: the node's name (--name), NMT state, 1001h, controller state with TEC/REC, 1017h, the 1016h
+///  consumers and
 ///    the PDO counters. Sampled at once on every NMT state change, communication error (every
 ///    controller state change is one: 8120h/8140h raised or cleared) and EMCY sent, and every
 ///    period (counters, 1017h written by SDO, errors raised while no EMCY may go out).
 ///  - IoSnapshot: the device's simulated I/O (devices::SimulatedIo), on every change. A
 ///    multi-port device publishes its I/O under each port's key. Numbers are published as they
-///    are, bools as 0/1, enums as the index of the choice in the signal's declaration.
+///    are, bools as 0/1, enums as the index of the choice in the signal's declaration; bools and
+///    enums carry their word too ("true", "on": IoValue.text, as `canfleet io get` prints them).
 ///  - Emcy: every EMCY frame a port's stack sent (canopen::Emcy::OnSent), with code, 1001h and the
 ///    five manufacturer bytes.
 /// Everything here runs on the node's event-loop thread; NodeTelemetry only copies the values and
@@ -18,7 +20,7 @@
 ///   node::TelemetrySettings telemetry_settings;               // main(): AddTelemetryOptions(app, ...)
 ///   auto telemetry = node::StartNodeTelemetry(telemetry_settings, settings, *log);  // before the node
 ///   node = std::make_unique<devices::DeviceNode>(...);
-///   if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options));
+///   if (telemetry) telemetry->Attach(*node, scheduler, node::BusNames(options), options.name);
 ///   ...
 ///   telemetry.reset();                                        // monitors see the node leave
 /// @endcode
@@ -73,8 +75,11 @@ class NodeTelemetryWiring {
   /// once, after the node is built, on the event-loop thread. A bus name beyond the IDL's 15
   /// characters is logged and nothing is published (the node runs without telemetry).
   /// @param scheduler the node's scheduler (the periodic sampling timer); must outlive this object.
+  /// @param name the node's name (--name, the topology's name under `canfleet up`), published in
+  ///        every port's NodeStatus.
   /// @throws std::invalid_argument when `buses` does not name every port.
-  void Attach(devices::DeviceNode& node, Scheduler& scheduler, const std::vector<std::string>& buses);
+  void Attach(devices::DeviceNode& node, Scheduler& scheduler, const std::vector<std::string>& buses,
+              const std::string& name = "");
 
   /// Samples every port's status now (the hooks and the timer call this).
   void Sample();

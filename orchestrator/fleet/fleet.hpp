@@ -18,6 +18,7 @@
 #include "clock/scheduler.hpp"
 #include "clock/wall_clock.hpp"
 #include "orchestrator/broker/broker.hpp"
+#include "orchestrator/broker_telemetry/scenario_telemetry.hpp"
 #include "orchestrator/control/control_handler.hpp"
 #include "orchestrator/fleet/external_adoption.hpp"
 #include "orchestrator/fleet/fault_manager.hpp"
@@ -53,6 +54,19 @@ struct FleetOptions {
   const transport::TimeConductor* conductor = nullptr;
   /// Seed of the random draws of faults that give none (topology `time.seed`).
   std::uint64_t seed = 0;
+  /// The topology file as given (`canfleet up FILE`, `canfleet test FILE`): result lines and
+  /// telemetry's verdicts name it. Empty: the topology's name.
+  std::string scenario_source;
+  /// The line of each scenario step in that file (topology::LoadedTopology::step_lines).
+  std::vector<int> step_lines;
+};
+
+/// Where the fleet's scenario stands: the runner's progress in the current cycle.
+struct ScenarioNow {
+  scenario::Progress progress;
+  int cycle = 0;                    ///< 1 for the first run, 2 for the first repetition, ... (0: none yet)
+  std::optional<TimePoint> origin;  ///< this cycle's start
+  TimePoint now{};                  ///< the fleet's scheduler time
 };
 
 class Fleet final : public control::ControlHandler, public scenario::FleetProbe {
@@ -85,10 +99,27 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
 
   control::Status Status() const;
 
-  /// An expectation of the scenario was decided (issue 21).
+  /// Adds a handler for every expectation of the scenario decided (issue 21; `canfleet test`
+  /// prints it, telemetry publishes it).
   void OnExpectation(std::function<void(const scenario::Result&)> handler) {
-    on_expectation_ = std::move(handler);
+    on_expectation_.push_back(std::move(handler));
   }
+  /// Adds a handler for every change of the scenario's state: it started, a step began, an
+  /// expectation was decided, it ended (telemetry's ScenarioStatus).
+  void OnScenarioChange(std::function<void()> handler) { on_scenario_change_.push_back(std::move(handler)); }
+  /// The result line of a decided expectation, as the log and `canfleet test` print it:
+  /// "pass  topologies/demo.textproto:284  quad-6-emcy: ... at t=42.993 s".
+  std::string ResultLine(const scenario::Result& result) const;
+  /// The line of scenario step `step` in the file (0: unknown).
+  int StepLine(int step) const;
+  /// The file as results name it (FleetOptions::scenario_source, else the topology's name).
+  const std::string& ScenarioSource() const {
+    return options_.scenario_source.empty() ? options_.topology.name() : options_.scenario_source;
+  }
+  ScenarioNow Scenario() const;
+  const std::string& TopologyName() const { return options_.topology.name(); }
+  bool VirtualTime() const { return options_.conductor != nullptr; }
+  bool HasScenario() const { return !options_.topology.scenario().empty(); }
   /// Every scenario step ran and every expectation was decided.
   void OnScenarioDone(std::function<void()> handler) { on_scenario_done_ = std::move(handler); }
   /// Every expectation of the scenario, decided or not, in file order.
@@ -168,8 +199,18 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   std::function<void()> on_ready_;
   std::function<void()> on_shutdown_request_;
   std::function<void(const control::FaultStatus&, bool)> on_fault_event_;
-  std::function<void(const scenario::Result&)> on_expectation_;
+  std::vector<std::function<void(const scenario::Result&)>> on_expectation_;
+  std::vector<std::function<void()>> on_scenario_change_;
   std::function<void()> on_scenario_done_;
+  void ScenarioChanged();
 };
+
+/// Publishes `fleet`'s scenario over DDS through `publisher` (issue 29): its ScenarioStatus (every
+/// second, and at once when a step begins or an expectation is decided) and a Verdict per decided
+/// expectation, with the result line the log and `canfleet test` print. Null when the topology
+/// has no scenario. The result must be destroyed before `fleet` and `publisher`.
+std::unique_ptr<broker::ScenarioTelemetry> PublishScenario(Fleet& fleet,
+                                                           telemetry::OrchestratorTelemetry& publisher,
+                                                           Scheduler& scheduler);
 
 }  // namespace canfleet::fleet

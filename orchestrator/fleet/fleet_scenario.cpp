@@ -7,6 +7,7 @@
 
 #include "orchestrator/fleet/fleet.hpp"
 #include "orchestrator/fleet/scenario_tap.hpp"
+#include "orchestrator/scenario/report.hpp"
 
 namespace canfleet::fleet {
 
@@ -17,20 +18,22 @@ void Fleet::WatchScenario() {
           .act = [this](const topology::Step& step) { RunStep(step); },
           .decided =
               [this](const scenario::Result& result) {
-                const auto& v = result.verdict;
-                const std::string line = std::string("expect ") + scenario::OutcomeName(v.outcome) + " " +
-                                         result.name + ": " + result.description +
-                                         (v.detail.empty() ? "" : ": " + v.detail);
-                if (v.outcome == scenario::Outcome::kPassed)
+                // The same line `canfleet test` prints and telemetry's Verdict carries.
+                const std::string line = "expect " + ResultLine(result);
+                if (result.verdict.outcome == scenario::Outcome::kPassed)
                   spdlog::info("{}", line);
                 else
                   spdlog::warn("{}", line);
-                if (on_expectation_) on_expectation_(result);
+                for (const auto& handler : on_expectation_)
+                  handler(result);
+                ScenarioChanged();
               },
+          .began = [this](int) { ScenarioChanged(); },
           .done =
               [this] {
                 if (runner_->Expectations() > 0)
                   spdlog::info("scenario: every step ran, every expectation decided");
+                ScenarioChanged();
                 if (on_scenario_done_) on_scenario_done_();
                 RepeatScenario();
               },
@@ -46,6 +49,32 @@ void Fleet::StartScenario() {
                  scenario_run_ > 1 ? " run " + std::to_string(scenario_run_) : "",
                  options_.topology.scenario_size(), runner_->Expectations());
   runner_->Start();
+  ScenarioChanged();
+}
+
+void Fleet::ScenarioChanged() {
+  for (const auto& handler : on_scenario_change_)
+    handler();
+}
+
+int Fleet::StepLine(int step) const {
+  return step >= 0 && step < static_cast<int>(options_.step_lines.size())
+             ? options_.step_lines[static_cast<std::size_t>(step)]
+             : 0;
+}
+
+std::string Fleet::ResultLine(const scenario::Result& result) const {
+  return scenario::ResultLine(ScenarioSource(), StepLine(result.step), result);
+}
+
+ScenarioNow Fleet::Scenario() const {
+  ScenarioNow now;
+  now.now = scheduler_.Now();
+  if (!runner_) return now;
+  now.progress = runner_->GetProgress();
+  now.origin = runner_->origin();
+  now.cycle = now.progress.started ? scenario_run_ : 0;
+  return now;
 }
 
 void Fleet::RepeatScenario() {
@@ -147,6 +176,70 @@ std::string Fleet::ControllerState(const scenario::PortAddress& port) const {
 
 double Fleet::LoadPercent(const std::string& bus) const {
   return broker_.Stats(bus, 0).load_percent;
+}
+
+namespace {
+
+std::uint16_t Count16(std::size_t n) {
+  return static_cast<std::uint16_t>(std::min<std::size_t>(n, UINT16_MAX));
+}
+
+double SecondsSince(std::optional<TimePoint> origin, TimePoint t) {
+  return origin ? std::chrono::duration<double>(t - *origin).count() : 0.0;
+}
+
+telemetry::VerdictResult ToTelemetry(scenario::Outcome outcome) {
+  switch (outcome) {
+    case scenario::Outcome::kPassed:
+      return telemetry::VerdictResult::kPass;
+    case scenario::Outcome::kFailed:
+      return telemetry::VerdictResult::kFail;
+    default:
+      return telemetry::VerdictResult::kSkip;
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<broker::ScenarioTelemetry> PublishScenario(Fleet& fleet,
+                                                           telemetry::OrchestratorTelemetry& publisher,
+                                                           Scheduler& scheduler) {
+  if (!fleet.HasScenario()) return nullptr;
+  auto sample = [&fleet] {
+    const ScenarioNow now = fleet.Scenario();
+    const scenario::Progress& p = now.progress;
+    telemetry::ScenarioStatusSnapshot s;
+    s.source = fleet.ScenarioSource();
+    s.scenario = fleet.TopologyName();
+    s.time_mode = fleet.VirtualTime() ? "virtual" : "real";
+    s.scenario_time_s = SecondsSince(now.origin, now.now);
+    s.cycle = static_cast<std::uint32_t>(std::max(now.cycle, 0));
+    s.running = p.started && !p.done;
+    s.expectations = Count16(p.expectations);
+    s.passed = Count16(p.passed);
+    s.failed = Count16(p.failed);
+    s.skipped = Count16(p.skipped);
+    s.pending = Count16(p.pending);
+    s.step = p.step;
+    s.step_time_s = p.step_time ? SecondsSince(now.origin, *p.step_time) : 0.0;
+    return s;
+  };
+  auto published = std::make_unique<broker::ScenarioTelemetry>(scheduler, publisher, std::move(sample));
+  broker::ScenarioTelemetry* telemetry = published.get();
+  fleet.OnScenarioChange([telemetry] { telemetry->Sample(); });
+  fleet.OnExpectation([&fleet, telemetry](const scenario::Result& result) {
+    const ScenarioNow now = fleet.Scenario();
+    telemetry->PublishVerdict({.source = fleet.ScenarioSource(),
+                               .index = Count16(static_cast<std::size_t>(std::max(result.index, 0))),
+                               .scenario = fleet.TopologyName(),
+                               .cycle = static_cast<std::uint32_t>(std::max(now.cycle, 1)),
+                               .result = ToTelemetry(result.verdict.outcome),
+                               .name = result.name,
+                               .line = static_cast<std::uint32_t>(std::max(fleet.StepLine(result.step), 0)),
+                               .text = fleet.ResultLine(result),
+                               .scenario_time_s = SecondsSince(now.origin, result.verdict.time)});
+  });
+  return published;
 }
 
 }  // namespace canfleet::fleet

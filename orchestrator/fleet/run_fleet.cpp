@@ -131,6 +131,8 @@ int RunFleet(const UpOptions& options) {
     fleet_options.wall_origin = host.wall_origin();
     fleet_options.repeat_scenario = true;
     fleet_options.seed = spec.time().seed();
+    fleet_options.scenario_source = options.topology.string();
+    fleet_options.step_lines = loaded.step_lines;
     UseHostTime(fleet_options, host.conductor());
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
@@ -147,6 +149,11 @@ int RunFleet(const UpOptions& options) {
   // Telemetry: the buses' statistics and the fault event log on DDS (the nodes publish their own);
   // the fleet runs without it if DDS fails.
   if (options.telemetry) host.StartTelemetry(options.dds, std::chrono::seconds(1));
+  // The scenario's status and verdicts (issue 29), for `canfleet top`, `canfleet watch` and any reader.
+  std::unique_ptr<broker::ScenarioTelemetry> scenario_telemetry;
+  if (auto* publisher = host.publisher())
+    scenario_telemetry = PublishScenario(*fleet, *publisher, host.scheduler());
+  const auto& topology_nodes = spec.node();
   fleet->OnFaultEvent([&](const control::FaultStatus& status, bool started) {
     broker::BrokerTelemetry* bus_telemetry = host.telemetry();
     if (bus_telemetry == nullptr) return;
@@ -156,6 +163,15 @@ int RunFleet(const UpOptions& options) {
         report.bus = status.spec().bus();
         report.fault_id = status.fault_id();
         report.kind = std::string(control::FaultKindName(status.spec().kind()));
+        // The node it is about, by its node-ID on the fault's bus (monitors show "node 5").
+        for (const auto& node : topology_nodes) {
+          if (node.name() != status.spec().node()) continue;
+          for (int p = 0; p < node.bus_size(); ++p) {
+            const int i = node.node_id_size() == 1 ? 0 : p;
+            if (node.bus(p) == report.bus && i < node.node_id_size() && node.node_id(i) <= 127)
+              report.target_node = static_cast<std::uint8_t>(node.node_id(i));
+          }
+        }
         report.parameters = {{"summary", status.summary()}};
         bus_telemetry->PublishFaultInjected(report);
       } else {
@@ -189,6 +205,7 @@ int RunFleet(const UpOptions& options) {
     if (!options.no_start) conductor->HoldUntilJoined(NodeProcesses(spec), kJoinTimeout);
   }
   io.run();
+  scenario_telemetry.reset();  // before the fleet, whose hooks call it
   control_server.reset();
   fleet.reset();
   spdlog::info("stopped");

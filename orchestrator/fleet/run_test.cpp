@@ -143,6 +143,8 @@ class FileRun {
       if (!options_.telemetry) fleet_options.node_arguments.push_back("--no-telemetry");
       fleet_options.wall_origin = host.wall_origin();
       fleet_options.seed = options_.seed ? *options_.seed : spec.time().seed();
+      fleet_options.scenario_source = report_.file;
+      fleet_options.step_lines = lines_;
       UseHostTime(fleet_options, host.conductor());
       fleet = std::make_unique<Fleet>(io, scheduler, host.broker(), host.server(), std::move(fleet_options));
       control_server =
@@ -164,7 +166,11 @@ class FileRun {
       Error(std::string("the fleet did not start: ") + e.what());
       return;
     }
-    if (options_.telemetry) host.StartTelemetry(options_.dds, std::chrono::seconds(1));
+    if (options_.telemetry && host.StartTelemetry(options_.dds, std::chrono::seconds(1))) {
+      // The scenario's status and verdicts on DDS (issue 29), as `canfleet up` publishes them.
+      publisher_ = host.publisher();
+      scenario_telemetry_ = PublishScenario(*fleet, *publisher_, scheduler);
+    }
 
     bool stopping = false;
     auto shutdown = [&](const std::string& why) {
@@ -201,11 +207,8 @@ class FileRun {
                     std::chrono::duration<double>(scheduler.Now() - begin).count());
       out_ << "      " << report_.file << ready << std::endl;
     });
-    fleet->OnExpectation([&](const scenario::Result& result) {
-      const int line =
-          result.step < static_cast<int>(lines_.size()) ? lines_[static_cast<std::size_t>(result.step)] : 0;
-      out_ << scenario::ResultLine(report_.file, line, result) << std::endl;
-    });
+    fleet->OnExpectation(
+        [&](const scenario::Result& result) { out_ << fleet->ResultLine(result) << std::endl; });
     std::optional<TimePoint> scenario_end;
     fleet->OnScenarioDone([&] {
       scenario_end = scheduler.Now();
@@ -220,6 +223,8 @@ class FileRun {
     if (auto* conductor = host.conductor()) conductor->HoldUntilJoined(NodeProcesses(spec), kJoinTimeout);
     io.run();
     watchdog_.reset();
+    scenario_telemetry_.reset();  // before the fleet, whose hooks call it
+    publisher_ = nullptr;
     if (auto* conductor = host.conductor()) {
       report_.factor = conductor->Factor();
       const auto& st = conductor->Stats();
@@ -253,7 +258,19 @@ class FileRun {
   void Error(const std::string& what) {
     if (!report_.error.empty()) return;
     report_.error = what;
-    out_ << "error " << report_.file << ": " << what << std::endl;
+    const std::string line = "error " + report_.file + ": " + what;
+    out_ << line << std::endl;
+    // A monitor sees the file's error too (Verdict index kFileVerdictIndex).
+    if (publisher_ != nullptr)
+      publisher_->PublishVerdict({.source = report_.file,
+                                  .index = telemetry::kFileVerdictIndex,
+                                  .scenario = report_.topology,
+                                  .cycle = 1,
+                                  .result = telemetry::VerdictResult::kError,
+                                  .name = "fleet",
+                                  .line = 0,
+                                  .text = line,
+                                  .scenario_time_s = 0});
   }
 
   const TestOptions& options_;
@@ -262,6 +279,8 @@ class FileRun {
   FileReport report_;
   std::vector<int> lines_;
   std::unique_ptr<Timer> watchdog_;
+  telemetry::OrchestratorTelemetry* publisher_ = nullptr;  ///< while the fleet runs with --telemetry
+  std::unique_ptr<broker::ScenarioTelemetry> scenario_telemetry_;
   bool refused_ = false;
 };
 

@@ -91,6 +91,9 @@ class BrokerHost {
   bool StartTelemetry(const telemetry::DdsOptions& dds, std::chrono::milliseconds period);
   /// The running telemetry, or nullptr.
   broker::BrokerTelemetry* telemetry() { return bus_telemetry_ ? &*bus_telemetry_ : nullptr; }
+  /// The running telemetry's publisher (for what else the orchestrator publishes: its scenario),
+  /// or nullptr.
+  telemetry::OrchestratorTelemetry* publisher() { return bus_telemetry_ ? &*publisher_ : nullptr; }
 
   /// `handler` runs, with "SIGINT" or "SIGTERM", when the process is asked to stop.
   void OnSignal(std::function<void(const char* name)> handler);

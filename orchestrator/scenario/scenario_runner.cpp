@@ -1,6 +1,8 @@
 #include "orchestrator/scenario/scenario_runner.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 
@@ -8,6 +10,7 @@ namespace canfleet::scenario {
 
 struct ScenarioRunner::Expectation {
   int step = 0;
+  int index = 0;  ///< among the expectations
   const topology::Step* spec = nullptr;
   int anchor = -1;  ///< the step named by `after`, or -1 (the scenario's start)
   std::unique_ptr<Judge> judge;
@@ -106,6 +109,7 @@ ScenarioRunner::ScenarioRunner(Scheduler& scheduler, const topology::Topology& t
     } else {
       auto e = std::make_unique<Expectation>();
       e->step = i;
+      e->index = static_cast<int>(expects_.size());
       e->spec = &step;
       e->name = StepName(step, i);
       if (!step.expect().after().empty()) {
@@ -145,6 +149,7 @@ void ScenarioRunner::Start() {
     Action* a = action.get();
     a->timer = std::make_unique<Timer>(scheduler_, [this, a] {
       a->ran = true;
+      Began(a->step);
       if (hooks_.act) hooks_.act(topology_.scenario(a->step));
       Anchored(a->step, scheduler_.Now());
       CheckDone();
@@ -191,7 +196,14 @@ void ScenarioRunner::AnchorLost(int step, const std::string& why) {
   }
 }
 
+void ScenarioRunner::Began(int step) {
+  last_step_ = step;
+  last_step_time_ = scheduler_.Now();
+  if (hooks_.began) hooks_.began(step);
+}
+
 void ScenarioRunner::OpenWindow(Expectation& e) {
+  Began(e.step);
   const TimePoint now = scheduler_.Now();
   const auto within = std::chrono::milliseconds(e.spec->expect().within_ms());
   // A window opens at its time even when that has passed (a timer or a round of the bus that ran
@@ -318,6 +330,7 @@ void ScenarioRunner::Finish(Expectation& e) {
     if (timer) timer->Cancel();
   Result result;
   result.step = e.step;
+  result.index = e.index;
   result.name = e.name;
   result.description = e.description;
   result.verdict = e.verdict();
@@ -391,8 +404,77 @@ void ScenarioRunner::Remember(const Heard& heard) {
 std::vector<Result> ScenarioRunner::Results() const {
   std::vector<Result> out;
   for (const auto& e : expects_)
-    out.push_back({e->step, e->name, e->description, e->verdict(), e->opened});
+    out.push_back({e->step, e->name, e->description, e->verdict(), e->opened, e->index});
   return out;
+}
+
+Progress ScenarioRunner::GetProgress() const {
+  Progress p;
+  p.expectations = expects_.size();
+  for (const auto& e : expects_) {
+    switch (e->reported ? e->verdict().outcome : Outcome::kPending) {
+      case Outcome::kPassed:
+        ++p.passed;
+        break;
+      case Outcome::kFailed:
+        ++p.failed;
+        break;
+      case Outcome::kSkipped:
+        ++p.skipped;
+        break;
+      case Outcome::kPending:
+        ++p.pending;
+        break;
+    }
+  }
+  p.started = started_;
+  p.done = Done();
+  if (last_step_ >= 0 && last_step_ < topology_.scenario_size()) {
+    const topology::Step& step = topology_.scenario(last_step_);
+    p.step = !step.name().empty() ? step.name()
+             : step.has_expect()  ? StepName(step, last_step_)
+                                  : ActionText(step);
+    p.step_time = last_step_time_;
+  }
+  return p;
+}
+
+std::string ActionText(const topology::Step& step) {
+  const auto lower = [](std::string text) {
+    for (char& c : text)
+      c = c == '_' ? '-' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return text;
+  };
+  switch (step.action_case()) {
+    case topology::Step::kInject: {
+      const auto& f = step.inject();
+      std::string text = "inject " + lower(control::FaultKind_Name(f.kind()));
+      if (!f.node().empty()) text += " " + f.node();
+      if (f.node().empty() && !f.bus().empty()) text += " " + f.bus();
+      return text;
+    }
+    case topology::Step::kClear: {
+      const auto& c = step.clear();
+      if (c.fault_id() != 0) return "clear " + std::to_string(c.fault_id());
+      if (!c.label().empty()) return "clear " + c.label();
+      return "clear all";
+    }
+    case topology::Step::kIo:
+      return "io " + step.io().node() + " " + step.io().name() + "=" + step.io().value();
+    case topology::Step::kNmt: {
+      std::string text = "nmt " + lower(control::NmtAction_Name(step.nmt().action()));
+      if (text.rfind("nmt nmt-", 0) == 0) text = "nmt " + text.substr(8);
+      if (!step.nmt().node().empty()) text += " " + step.nmt().node();
+      return text;
+    }
+    case topology::Step::kSdo: {
+      char index[16];
+      std::snprintf(index, sizeof index, "%04Xh", step.sdo().index());
+      return "sdo write " + step.sdo().node() + " " + index + " sub " + std::to_string(step.sdo().subindex());
+    }
+    default:
+      return "step";
+  }
 }
 
 bool ScenarioRunner::Done() const {

@@ -45,7 +45,24 @@ struct Result {
   std::string description;  ///< "EMCY 8130h from quad-6 within 1500 ms after cut-hb"
   Verdict verdict;
   std::optional<TimePoint> opened;  ///< when its window opened (unset: never)
+  int index = 0;                    ///< among the scenario's expectations (file order, 0-based)
 };
+
+/// Where a run stands (for monitors: telemetry's ScenarioStatus).
+struct Progress {
+  std::size_t expectations = 0;
+  std::size_t passed = 0, failed = 0, skipped = 0, pending = 0;
+  bool started = false;
+  bool done = false;  ///< every step ran and every expectation is decided
+  /// The latest step that began: an action that ran or an expectation whose window opened. Its
+  /// name, or for an unnamed action what it does ("io quad-5 AIN1.voltage_mV=1800"); "" before.
+  std::string step;
+  std::optional<TimePoint> step_time;
+};
+
+/// What an action step does, in a few words: "inject heartbeat-loss quad-5", "clear hb-loss",
+/// "io quad-5 AIN1.voltage_mV=1800", "nmt start quad-6", "sdo write quad-5 1017h sub 0".
+std::string ActionText(const topology::Step& step);
 
 struct RunnerOptions {
   /// How often reads are repeated while a window is open: reads over the bus or a node
@@ -68,6 +85,7 @@ class ScenarioRunner {
   struct Hooks {
     std::function<void(const topology::Step&)> act;  ///< runs an action step (inject, io, ...)
     std::function<void(const Result&)> decided;      ///< an expectation was decided
+    std::function<void(int step)> began;             ///< an action ran or an expectation's window opened
     std::function<void()> done;                      ///< every step ran and every expectation is decided
   };
 
@@ -88,6 +106,8 @@ class ScenarioRunner {
 
   /// Every expectation in file order; decided ones have their verdict.
   std::vector<Result> Results() const;
+  /// Counts of this run's verdicts and the step it is at.
+  Progress GetProgress() const;
   std::size_t Expectations() const { return expects_.size(); }
   bool Done() const;
   /// When the scenario started (unset before Start).
@@ -112,6 +132,7 @@ class ScenarioRunner {
   /// `by`: the frame the anchor saw (a window opened by it judges only the frames behind it).
   void Anchored(int step, TimePoint anchor, std::optional<FrameRef> by = std::nullopt);
   void AnchorLost(int step, const std::string& why);
+  void Began(int step);
   void OpenWindow(Expectation& e);
   void Replay(Expectation& e);
   std::size_t BusIndex(const std::string& bus);
@@ -129,6 +150,8 @@ class ScenarioRunner {
   Hooks hooks_;
   RunnerOptions options_;
   TimePoint origin_{};
+  int last_step_ = -1;  ///< the latest step that began (GetProgress)
+  TimePoint last_step_time_{};
   bool started_ = false;
   bool done_reported_ = false;
   std::vector<std::unique_ptr<Expectation>> expects_;

@@ -248,12 +248,13 @@ net=$(fleet network)
 # ---- 2. DDS telemetry across containers -----------------------------------------------------------
 top_out=$(timeout 90 docker run --rm --network "$net" "$CANFLEET_IMAGE" \
   canfleet-top --once --color never --width 200 --height 40 2>&1) || true
-rows=$(printf '%s\n' "$top_out" | grep -cE '^can[01] +[0-9]+ +(quad-controller|generic) +OPER' || true)
+# A node row: the selection marker column, the node's name, bus, node-ID, device, NMT state.
+rows=$(printf '%s\n' "$top_out" | grep -cE '^[> ] [^ ]+ +can[01] +[0-9]+ +(quad-controller|generic) +operational' || true)
 if [ "$rows" -ne 5 ]; then
   printf '%s\n' "$top_out" >&2
   fail "canfleet-top in a container on $net showed $rows of 5 nodes operational"
 fi
-pass "DDS telemetry across containers: canfleet-top --once on network $net shows 5 nodes OPER"
+pass "DDS telemetry across containers: canfleet-top --once on network $net shows 5 nodes operational"
 
 # ---- socketcand on the host's loopback -----------------------------------------------------------
 # `< hi >` from can0's published port, then a frame in raw mode (socketcand protocol). compose.yaml

@@ -205,12 +205,12 @@ expect_eq() { # DESCRIPTION ACTUAL EXPECTED
 }
 emcy_is() { [ "$(node_get "$1" "$2" emcy_count)" -gt "$3" ] && [ "$(node_get "$1" "$2" last_emcy.code)" = "$4" ]; }
 nmt_is() { [ "$(node_get "$1" "$2" nmt_state)" = "$3" ]; }
-# top_oper: canfleet-top --once at a monitor slot; prints "can0 can1" counts of OPER rows.
+# top_once: canfleet-top --once at a monitor slot; count_oper BUS counts its operational rows.
 top_once() {
   swarm top --once --wait 20 --color never --width 160 --height 200 2>&1
 }
 count_oper() { # BUS < top output
-  grep -cE "^$1 +[0-9]+ +[^ ]+ +OPER" || true
+  grep -cE "^[> ] [^ ]+ +$1 +[0-9]+ +[^ ]+ +operational" || true
 }
 task_container() { # SERVICE SLOT: the running container of that task (this host)
   docker ps --filter "label=com.docker.swarm.service.name=${stack}_$1" \
@@ -301,12 +301,12 @@ for attempt in 1 2 3; do
   c0=$(printf '%s\n' "$top_out" | count_oper can0)
   c1=$(printf '%s\n' "$top_out" | count_oper can1)
   [ "$c0" = 20 ] && [ "$c1" = 10 ] && break
-  log "canfleet-top attempt $attempt: can0 $c0/20, can1 $c1/10 OPER"
+  log "canfleet-top attempt $attempt: can0 $c0/20, can1 $c1/10 operational"
   settle 60 "before canfleet-top attempt $((attempt + 1))"
 done
 if [ "$c0" != 20 ] || [ "$c1" != 10 ]; then
   printf '%s\n' "$top_out" | head -60 >&2
-  fail "canfleet-top on the overlay showed can0 $c0/20 and can1 $c1/10 nodes OPER"
+  fail "canfleet-top on the overlay showed can0 $c0/20 and can1 $c1/10 nodes operational"
 fi
 # The control: the same configuration in a container at an address that is no monitor slot finds no
 # writer. What canfleet-top saw came by unicast to its slot (on one host the overlay would carry
@@ -316,7 +316,7 @@ ctl_out=$(docker run --rm --network "${stack}_fleet" -e CANFLEET_DDS_CONFIG= \
   "$CANFLEET_IMAGE" canfleet-top --once --wait 5 --color never --width 160 --height 10 2>&1) || true
 printf '%s\n' "$ctl_out" | grep -q ' 0 nodes on 0 buses' ||
   { printf '%s\n' "$ctl_out" | head -5 >&2; fail "a monitor outside the monitor slots saw writers: discovery is not what the stack says"; }
-pass "DDS across the overlay, unicast discovery: canfleet-top --once at a monitor slot shows all 30 nodes OPER (can0 20, can1 10); the same configuration at an address that is no slot sees 0 nodes ($(elapsed "$t"))"
+pass "DDS across the overlay, unicast discovery: canfleet-top --once at a monitor slot shows all 30 nodes operational (can0 20, can1 10); the same configuration at an address that is no slot sees 0 nodes ($(elapsed "$t"))"
 
 # ---- 5. kill a node task: its consumer's heartbeat-loss EMCY and its return ------------------------
 watch_log="$work/watch.log"
@@ -359,11 +359,11 @@ for attempt in 1 2 3; do
   c0=$(printf '%s\n' "$top_out" | count_oper can0)
   c1=$(printf '%s\n' "$top_out" | count_oper can1)
   [ "$c0" = 20 ] && [ "$c1" = 10 ] && break
-  log "canfleet-top after the kill, attempt $attempt: can0 $c0/20, can1 $c1/10 OPER"
+  log "canfleet-top after the kill, attempt $attempt: can0 $c0/20, can1 $c1/10 operational"
   settle 60 "before canfleet-top attempt $((attempt + 1))"
 done
-[ "$c0" = 20 ] && [ "$c1" = 10 ] || { printf '%s\n' "$top_out" | head -60 >&2; fail "after the kill canfleet-top showed can0 $c0/20, can1 $c1/10 OPER"; }
-pass "the task came back: same slot, same node-ID and name, reconfigured (1016h.1 = 000205DCh, 1017h = 500), can0-node-4 EMCY 0000h (control API and canfleet-watch); after NMT start 30 operational, and a new canfleet-top sees all 30 OPER ($(elapsed "$t"))"
+[ "$c0" = 20 ] && [ "$c1" = 10 ] || { printf '%s\n' "$top_out" | head -60 >&2; fail "after the kill canfleet-top showed can0 $c0/20, can1 $c1/10 operational"; }
+pass "the task came back: same slot, same node-ID and name, reconfigured (1016h.1 = 000205DCh, 1017h = 500), can0-node-4 EMCY 0000h (control API and canfleet-watch); after NMT start 30 operational, and a new canfleet-top sees all 30 operational ($(elapsed "$t"))"
 grep -E 'can0 #4 EMCY (8130|0000)h' "$watch_log" | tail -2 | sed 's/^/swarm-test:   watch: /' || true
 
 # ---- 6. figures ----------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 #include "tools/telemetry/event_format.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <utility>
@@ -71,6 +72,11 @@ std::string FormatTime(WallTime time) {
   return text;
 }
 
+std::string FormatTimeOfDay(WallTime time) {
+  const std::string full = FormatTime(time);  // "2024-05-01T12:00:01.234Z"
+  return full.size() >= 23 ? full.substr(11, 12) : full;
+}
+
 std::string JsonString(std::string_view text) {
   std::string out = "\"";
   for (const char c : text) {
@@ -114,13 +120,36 @@ std::string Printf(const char* format, auto... args) {
 }
 
 std::string NodeLabel(const FleetEvent& e) {
-  return e.node_id == 0 ? e.bus : e.bus + " #" + std::to_string(e.node_id);
+  if (e.node_id == 0) return e.bus;
+  return e.bus + " #" + std::to_string(e.node_id) + (e.name.empty() ? "" : " " + e.name);
+}
+
+/// The part of a verdict's result line after "<name>: ": what was expected and what was seen.
+std::string_view VerdictDetail(const VerdictSample& v) {
+  const std::string_view text = v.text;
+  const std::string key = "  " + v.name + ": ";
+  const std::size_t at = text.find(key);
+  return at == std::string_view::npos ? text : text.substr(at + key.size());
+}
+
+std::string VerdictText(const VerdictSample& v, bool compact) {
+  if (!compact)
+    return (v.scenario.empty() ? std::string("scenario") : v.scenario) + " VERDICT cycle " +
+           std::to_string(v.cycle) + ": " + v.text;
+  return std::string(telemetry::ToString(v.result)) + " " + v.name + " (cycle " + std::to_string(v.cycle) +
+         "): " + std::string(VerdictDetail(v));
 }
 
 }  // namespace
 
-std::string FormatEventText(const FleetEvent& e) {
-  std::string line = FormatTime(e.time) + " " + NodeLabel(e) + " ";
+std::string FormatEventText(const FleetEvent& e, bool compact) {
+  const std::string time = compact ? FormatTimeOfDay(e.time) : FormatTime(e.time);
+  if (e.kind == EventKind::kVerdict) {
+    std::string line = time + " " + (e.verdict ? VerdictText(*e.verdict, compact) : "VERDICT ?");
+    if (e.replay) line += " [history]";
+    return line;
+  }
+  std::string line = time + " " + NodeLabel(e) + " ";
   switch (e.kind) {
     case EventKind::kEmcy: {
       const auto& m = e.emcy->emcy;
@@ -154,6 +183,8 @@ std::string FormatEventText(const FleetEvent& e) {
     case EventKind::kErrorRegister:
       line += "ERROR-REGISTER " + e.from + " -> " + e.to;
       break;
+    case EventKind::kVerdict:
+      break;
   }
   if (e.replay) line += " [history]";
   return line;
@@ -163,6 +194,7 @@ std::string FormatEventJson(const FleetEvent& e) {
   std::string json = "{\"time\":" + JsonString(FormatTime(e.time)) +
                      ",\"type\":" + JsonString(ToString(e.kind)) + ",\"bus\":" + JsonString(e.bus) +
                      ",\"node\":" + std::to_string(e.node_id);
+  if (!e.name.empty()) json += ",\"name\":" + JsonString(e.name);
   switch (e.kind) {
     case EventKind::kEmcy: {
       const auto& m = e.emcy->emcy;
@@ -184,6 +216,19 @@ std::string FormatEventJson(const FleetEvent& e) {
         json += (i ? "," : "") + JsonString(f.parameters[i].first) + ":" + JsonString(f.parameters[i].second);
       }
       json += "},\"bus_time_ns\":" + std::to_string(f.bus_time.count());
+      break;
+    }
+    case EventKind::kVerdict: {
+      if (!e.verdict) break;
+      const auto& v = *e.verdict;
+      char time[40];
+      std::snprintf(time, sizeof time, "%.3f", v.scenario_time_s);
+      json += ",\"source\":" + JsonString(v.source) + ",\"index\":" + std::to_string(v.index) +
+              ",\"scenario\":" + JsonString(v.scenario) + ",\"cycle\":" + std::to_string(v.cycle) +
+              ",\"result\":" + JsonString(telemetry::ToString(v.result)) + ",\"name\":" + JsonString(v.name) +
+              ",\"line\":" + std::to_string(v.line) + ",\"text\":" + JsonString(v.text) +
+              ",\"text_cut\":" + (v.text_cut ? "true" : "false") +
+              ",\"scenario_time_s\":" + (std::isfinite(v.scenario_time_s) ? std::string(time) : "null");
       break;
     }
     case EventKind::kHeartbeatConsumer:

@@ -1,5 +1,6 @@
 // canfleet-fake-fleet: publishes the telemetry of a synthetic fleet (NodeStatus, IoSnapshot, Emcy
-// and, with --orchestrator, BusStats and FaultEvent) through the real publishers. For the
+// and, with --orchestrator, BusStats, FaultEvent and a scenario's ScenarioStatus and Verdicts)
+// through the real publishers. For the
 // telemetry tests and benchmarks that need many nodes or scripted faults cheaply; a stand-in for
 // node processes, not a simulation of CANopen (canfleet-node and canfleet-broker publish the real
 // thing).
@@ -8,6 +9,7 @@
 // with "ok <command>" on stdout once handed to the publishers):
 //   fault <node> passive|bus-off|heartbeat   recover <node>   emcy <node> <hex code>
 //   nmt <node> OPER|PREOP|STOP               flush            quit
+//   verdict pass|FAIL|skip <name> [text]     (with --orchestrator: a Verdict of scenario "fake")
 #include <poll.h>
 #include <unistd.h>
 
@@ -65,7 +67,8 @@ std::chrono::milliseconds Seconds(double s) {
 class FakeFleet {
  public:
   FakeFleet(const Participant& participant, const std::string& bus, int first, int count,
-            const std::string& device, NodeTelemetryOptions base, bool orchestrator, bool io)
+            const std::string& device, const std::string& names, NodeTelemetryOptions base, bool orchestrator,
+            bool io)
       : bus_(bus) {
     for (int i = 0; i < count; ++i) {
       auto node = std::make_unique<FakeNode>();
@@ -74,9 +77,10 @@ class FakeFleet {
       options.bus = bus;
       options.node_id = node->id;
       options.device = device;
+      if (!names.empty()) options.name = names + "-" + std::to_string(node->id);
       if (io) {
         options.inputs = {{"AIN1.voltage_V", "V"}, {"TC1.temperature_C", "C"}};
-        options.outputs = {{"POUT1.current_mA", "mA"}, {"DOUT1.on", ""}};
+        options.outputs = {{"POUT1.current_mA", "mA"}, {"DOUT1.on", "", {"false", "true"}}};
       }
       node->status.nmt_state = NmtState::kOperational;
       node->status.heartbeat_producer_ms = 100;
@@ -130,6 +134,10 @@ class FakeFleet {
       stats.top_cob_ids[1] = {0x182, 10.0f};
       stats.top_cob_ids[2] = {0x701, 10.0f};
       orchestrator_->UpdateBusStats(stats);
+      if (scenario_.expectations > 0) {  // a scenario's clock, once it decided something
+        scenario_.scenario_time_s = std::chrono::duration<double>(Clock::now() - scenario_start_).count();
+        orchestrator_->UpdateScenario(scenario_);
+      }
     }
   }
 
@@ -172,6 +180,7 @@ class FakeFleet {
       faults_[id] = arg;
       return "";
     }
+    if (verb == "verdict") return Verdict(id, line);
     if (verb == "recover") {
       const auto it = faults_.find(id);
       PublishFault(id, FaultAction::kCleared, it == faults_.end() ? "passive" : it->second);
@@ -256,6 +265,54 @@ class FakeFleet {
     node.telemetry->UpdateStatus(s);
   }
 
+  /// "verdict pass|FAIL|skip NAME [TEXT]": scenario "fake" (source "fake.textproto") decides its
+  /// next expectation; its ScenarioStatus counts it.
+  std::string Verdict(int, const std::string& line) {
+    if (!orchestrator_) return "verdict needs --orchestrator";
+    std::istringstream in(line);
+    std::string verb, result, name;
+    in >> verb >> result >> name;
+    std::string text;
+    std::getline(in, text);
+    if (!text.empty() && text.front() == ' ') text.erase(0, 1);
+    VerdictResult r;
+    if (result == "pass")
+      r = VerdictResult::kPass;
+    else if (result == "FAIL")
+      r = VerdictResult::kFail;
+    else if (result == "skip")
+      r = VerdictResult::kSkip;
+    else
+      return "unknown result " + result;
+    if (name.empty()) return "verdict needs a name";
+    const double t = std::chrono::duration<double>(Clock::now() - scenario_start_).count();
+    (r == VerdictResult::kPass   ? scenario_.passed
+     : r == VerdictResult::kFail ? scenario_.failed
+                                 : scenario_.skipped)++;
+    const auto index =
+        static_cast<std::uint16_t>(scenario_.passed + scenario_.failed + scenario_.skipped - 1);
+    scenario_.step = name;
+    scenario_.step_time_s = t;
+    scenario_.scenario_time_s = t;
+    scenario_.expectations =
+        std::max<std::uint16_t>(scenario_.expectations, static_cast<std::uint16_t>(index + 1));
+    scenario_.pending = 0;
+    orchestrator_->UpdateScenario(scenario_);
+    std::string out = ToString(r);
+    out.resize(6, ' ');
+    out += "fake.textproto:" + std::to_string(index + 10) + "  " + name + ": " + text;
+    orchestrator_->PublishVerdict({.source = scenario_.source,
+                                   .index = index,
+                                   .scenario = scenario_.scenario,
+                                   .cycle = scenario_.cycle,
+                                   .result = r,
+                                   .name = name,
+                                   .line = static_cast<std::uint32_t>(index + 10),
+                                   .text = out,
+                                   .scenario_time_s = t});
+    return "";
+  }
+
   void PublishFault(int node, FaultAction action, const std::string& kind) {
     if (!orchestrator_) return;
     if (action == FaultAction::kInjected) ++error_frames_;
@@ -286,6 +343,9 @@ class FakeFleet {
   std::uint32_t next_fault_id_ = 0;
   std::uint64_t frames_ = 0;
   std::uint64_t error_frames_ = 0;
+  ScenarioStatusSnapshot scenario_{
+      .source = "fake.textproto", .scenario = "fake", .time_mode = "real", .cycle = 1, .running = true};
+  Clock::time_point scenario_start_ = Clock::now();
 };
 
 }  // namespace
@@ -296,6 +356,7 @@ int main(int argc, char** argv) {
   AddDdsOptions(app, dds, DdsDiscovery::kMonitorsOnly);
   std::string bus = "can0";
   std::string device = "fake-io";
+  std::string names = "fake";
   int nodes = 20;
   int first = 1;
   double period = 1.0;
@@ -319,6 +380,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 127))
       ->capture_default_str();
   app.add_option("--device", device, "device name in NodeStatus")->capture_default_str();
+  app.add_option("--names", names, "node names in NodeStatus: NAMES-<node-id> (empty: none)")
+      ->capture_default_str();
   app.add_option("--period", period, "status period, seconds")->capture_default_str();
   app.add_option("--min-interval", min_interval, "coalescing window, seconds")->capture_default_str();
   app.add_option("--update", update, "how often each fake node hands over a status, seconds")
@@ -343,7 +406,7 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   try {
     Participant participant(dds);
-    FakeFleet fleet(participant, bus, first, std::min(nodes, 128 - first), device,
+    FakeFleet fleet(participant, bus, first, std::min(nodes, 128 - first), device, names,
                     NodeTelemetryOptions{.period = Seconds(period), .min_interval = Seconds(min_interval)},
                     orchestrator, io);
     std::cout << "ready nodes=" << nodes << " rss_kb=" << StatusKb("VmRSS:") << std::endl;

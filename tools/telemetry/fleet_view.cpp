@@ -28,14 +28,16 @@ const char* ToString(EventKind kind) {
       return "emcy";
     case EventKind::kFault:
       return "fault";
+    case EventKind::kVerdict:
+      return "verdict";
   }
   return "?";
 }
 
 std::optional<EventKind> ParseEventKind(std::string_view text) {
-  for (auto kind :
-       {EventKind::kNodeSeen, EventKind::kNodeGone, EventKind::kNmt, EventKind::kController,
-        EventKind::kErrorRegister, EventKind::kHeartbeatConsumer, EventKind::kEmcy, EventKind::kFault}) {
+  for (auto kind : {EventKind::kNodeSeen, EventKind::kNodeGone, EventKind::kNmt, EventKind::kController,
+                    EventKind::kErrorRegister, EventKind::kHeartbeatConsumer, EventKind::kEmcy,
+                    EventKind::kFault, EventKind::kVerdict}) {
     if (text == ToString(kind)) return kind;
   }
   return std::nullopt;
@@ -56,6 +58,10 @@ FleetView::FleetView(WallTime started, std::size_t recent_capacity)
 
 void FleetView::Emit(FleetEvent event, std::vector<FleetEvent>* events) {
   event.replay = event.time < started_;
+  if (event.node_id != 0 && event.name.empty() && event.kind != EventKind::kVerdict) {
+    if (const auto it = nodes_.find({event.bus, event.node_id}); it != nodes_.end())
+      event.name = it->second.status.name;
+  }
   // Samples of different topics arrive in batches per topic: keep the list in time order.
   auto at = recent_.end();
   while (at != recent_.begin() && std::prev(at)->time > event.time)
@@ -108,13 +114,20 @@ void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& me
       early_emcy_.erase(early);
     }
     nodes_.emplace(key, std::move(row));
+    // Events of the node that came before its first status (an EMCY is taken before the status
+    // it changed) get its name now.
+    if (!sample.name.empty()) {
+      for (FleetEvent& e : recent_)
+        if (e.name.empty() && e.kind != EventKind::kVerdict && e.node_id == key.node_id && e.bus == key.bus)
+          e.name = sample.name;
+    }
     last_new_node_ = std::max(last_new_node_, std::chrono::system_clock::now());
     Emit({.time = meta.source_time,
           .kind = EventKind::kNodeSeen,
           .bus = key.bus,
           .node_id = key.node_id,
           .from = "",
-          .to = telemetry::ShortName(sample.nmt_state)},
+          .to = telemetry::StateName(sample.nmt_state)},
          events);
     return;
   }
@@ -130,13 +143,13 @@ void FleetView::ApplyStatus(const NodeStatusSample& sample, const SampleMeta& me
           .to = std::move(to)},
          events);
   };
-  if (!row.alive) event(EventKind::kNodeSeen, "gone", telemetry::ShortName(sample.nmt_state));
+  if (!row.alive) event(EventKind::kNodeSeen, "gone", telemetry::StateName(sample.nmt_state));
   if (old.nmt_state != sample.nmt_state) {
-    event(EventKind::kNmt, telemetry::ShortName(old.nmt_state), telemetry::ShortName(sample.nmt_state));
+    event(EventKind::kNmt, telemetry::StateName(old.nmt_state), telemetry::StateName(sample.nmt_state));
   }
   if (old.controller_state != sample.controller_state) {
-    event(EventKind::kController, telemetry::ShortName(old.controller_state),
-          telemetry::ShortName(sample.controller_state));
+    event(EventKind::kController, telemetry::StateName(old.controller_state),
+          telemetry::StateName(sample.controller_state));
   }
   if (old.error_register != sample.error_register) {
     event(EventKind::kErrorRegister, Hex2(old.error_register), Hex2(sample.error_register));
@@ -221,6 +234,30 @@ void FleetView::Apply(const FaultEventSample& sample, const SampleMeta& meta,
         .node_id = sample.target_node,
         .fault = sample},
        events);
+}
+
+void FleetView::Apply(const VerdictSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events) {
+  // A dispose (the fleet stopped) carries no verdict: only samples with data are events.
+  if (!meta.valid_data) return;
+  Emit({.time = meta.source_time, .kind = EventKind::kVerdict, .verdict = sample}, events);
+}
+
+void FleetView::Apply(const ScenarioStatusSample& sample, const SampleMeta& meta, std::vector<FleetEvent>*) {
+  if (meta.valid_data) {
+    ScenarioRow& row = scenarios_[sample.source];
+    row.status = sample;
+    row.alive = meta.alive;
+    row.last_sample = meta.source_time;
+  } else if (const auto it = scenarios_.find(sample.source); it != scenarios_.end()) {
+    it->second.alive = meta.alive;
+  }
+  // A scenario whose fleet stopped says nothing any more: it is dropped, like a removed bus.
+  if (!meta.alive) scenarios_.erase(sample.source);
+}
+
+bool IsStale(const ScenarioRow& row, WallTime now) {
+  const auto period = std::max<std::chrono::milliseconds>(row.status.publish_period, std::chrono::seconds(1));
+  return now - row.last_sample > 3 * period;
 }
 
 bool IsStale(const NodeRow& row, WallTime now) {

@@ -23,6 +23,8 @@ using telemetry::IoSnapshotSample;
 using telemetry::NodeKey;
 using telemetry::NodeStatusSample;
 using telemetry::SampleMeta;
+using telemetry::ScenarioStatusSample;
+using telemetry::VerdictSample;
 using WallTime = std::chrono::system_clock::time_point;
 
 enum class EventKind : std::uint8_t {
@@ -33,10 +35,11 @@ enum class EventKind : std::uint8_t {
   kErrorRegister,      ///< 1001h change
   kHeartbeatConsumer,  ///< a heartbeat consumer entry changed state (e.g. timed out)
   kEmcy,
-  kFault,  ///< fault injected or cleared by the orchestrator
+  kFault,    ///< fault injected or cleared by the orchestrator
+  kVerdict,  ///< an expectation of a scenario decided (the Verdict topic)
 };
 
-/// "seen", "gone", "nmt", "controller", "error-register", "hb-consumer", "emcy", "fault".
+/// "seen", "gone", "nmt", "controller", "error-register", "hb-consumer", "emcy", "fault", "verdict".
 const char* ToString(EventKind kind);
 std::optional<EventKind> ParseEventKind(std::string_view text);
 
@@ -44,12 +47,14 @@ struct FleetEvent {
   WallTime time{};  ///< the publisher's source timestamp
   EventKind kind = EventKind::kNmt;
   std::string bus{};
-  std::uint8_t node_id = 0;  ///< 0 for bus-wide faults
+  std::uint8_t node_id = 0;  ///< 0 for bus-wide faults and verdicts
+  std::string name{};        ///< the node's topology name when known (NodeStatus.name)
   std::string from{};        ///< state changes: old and new value as text
   std::string to{};
   std::uint8_t peer_node = 0;  ///< kHeartbeatConsumer: the monitored node
   std::optional<EmcySample> emcy{};
   std::optional<FaultEventSample> fault{};
+  std::optional<VerdictSample> verdict{};
   /// Happened before the monitor started (delivered from transient-local history).
   bool replay = false;
 };
@@ -76,6 +81,13 @@ struct NodeRow {
   std::optional<IoSnapshotSample> io{};
 };
 
+/// A scenario as its ScenarioStatus shows it, and its latest verdicts.
+struct ScenarioRow {
+  ScenarioStatusSample status;
+  bool alive = true;  ///< false once disposed (its fleet stopped) or without writers
+  WallTime last_sample{};
+};
+
 struct BusRow {
   std::optional<BusStatsSample> stats{};
   std::map<std::uint32_t, FaultEventSample> active_faults{};  ///< by fault_id
@@ -92,9 +104,13 @@ class FleetView {
   void Apply(const IoSnapshotSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
   void Apply(const BusStatsSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
   void Apply(const FaultEventSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
+  void Apply(const VerdictSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
+  void Apply(const ScenarioStatusSample& sample, const SampleMeta& meta, std::vector<FleetEvent>* events);
 
   const std::map<NodeKey, NodeRow>& nodes() const { return nodes_; }
   const std::map<std::string, BusRow>& buses() const { return buses_; }
+  /// Scenarios by source (the topology file).
+  const std::map<std::string, ScenarioRow>& scenarios() const { return scenarios_; }
   /// The latest events, ordered by time (oldest first).
   const std::deque<FleetEvent>& recent() const { return recent_; }
   /// When the set of known nodes last grew (used by `top --once` to wait for discovery).
@@ -110,6 +126,7 @@ class FleetView {
   std::map<NodeKey, NodeRow> nodes_{};
   std::map<NodeKey, std::deque<EmcyRecord>> early_emcy_{};  ///< EMCYs of nodes not seen yet
   std::map<std::string, BusRow> buses_{};
+  std::map<std::string, ScenarioRow> scenarios_{};
   std::deque<FleetEvent> recent_{};
   WallTime last_new_node_{};
 };
@@ -119,5 +136,6 @@ class FleetView {
 bool IsFaulted(const NodeRow& row, WallTime now);
 /// True if no status arrived for 3 publish periods (at least 3 s).
 bool IsStale(const NodeRow& row, WallTime now);
+bool IsStale(const ScenarioRow& row, WallTime now);
 
 }  // namespace canfleet::tools

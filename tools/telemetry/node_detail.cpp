@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tools/telemetry/event_format.hpp"
+#include "tools/telemetry/text_fit.hpp"
 
 namespace canfleet::tools {
 
@@ -22,10 +23,9 @@ std::string Printf(const char* format, auto... args) {
   return text;
 }
 
-std::string Fit(std::string line, int width) {
-  if (width > 0 && line.size() > static_cast<std::size_t>(width))
-    line.resize(static_cast<std::size_t>(width));
-  return line;
+/// Lines too long for the screen are cut at a word boundary and end in "...".
+std::string Fit(const std::string& line, int width) {
+  return FitLine(line, width);
 }
 
 std::string Consumers(const NodeStatusSample& s) {
@@ -33,13 +33,15 @@ std::string Consumers(const NodeStatusSample& s) {
   std::string text;
   for (const auto& c : s.heartbeat_consumers)
     text += Printf("%s#%u %s (%u ms, last %s)", text.empty() ? "" : ", ", c.node_id,
-                   telemetry::ToString(c.state), c.time_ms, telemetry::ShortName(c.last_state));
+                   telemetry::ToString(c.state), c.time_ms, telemetry::StateName(c.last_state));
   return text;
 }
 
-/// "AIN1.voltage_mV      1200 mV": the name in `name_width`, the value and unit after it.
+/// "AIN1.voltage_mV      1200 mV", "PS.state  on": the name in `name_width`, then the value with
+/// its unit, or a bool's or an enum's word (IoValue.text: what `canfleet io get` prints).
 std::string IoCell(const telemetry::IoValueSample& v, int name_width) {
-  const std::string value = FormatIoValue(v.value) + (v.unit.empty() ? "" : " " + v.unit);
+  const std::string value =
+      !v.text.empty() ? v.text : FormatIoValue(v.value) + (v.unit.empty() ? "" : " " + v.unit);
   return Printf("%-*.*s %12s", name_width, name_width, v.name.c_str(), value.c_str());
 }
 
@@ -81,23 +83,28 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   }
   const NodeRow& row = it->second;
   const NodeStatusSample& s = row.status;
-  std::string state = row.alive ? telemetry::ShortName(s.nmt_state) : (row.disposed ? "LEFT" : "LOST");
+  std::string state = row.alive ? telemetry::StateName(s.nmt_state) : (row.disposed ? "LEFT" : "LOST");
+  const std::string who_named = s.name.empty() ? who : who + " " + s.name;
   if (IsStale(row, now)) state = "STALE";
 
-  top.push_back(paint(kBold, Fit(Printf("canfleet top  %s  %s  %s  (node detail)", FormatTime(now).c_str(),
-                                        who.c_str(), s.device.c_str()),
-                                 width)));
-  top.push_back(
-      Fit(Printf("NMT %s  controller %s  TEC %u  REC %u  error register (1001h) %02Xh  uptime %s  "
-                 "status %s old",
-                 state.c_str(), telemetry::ShortName(s.controller_state), s.tec, s.rec, s.error_register,
-                 FormatUptime(s.uptime).c_str(), FormatAge(now - row.last_sample).c_str()),
-          width));
-  top.push_back(Fit(Printf("heartbeat: produced every %u ms (1017h); consumed (1016h): %s",
-                           s.heartbeat_producer_ms, Consumers(s).c_str()),
+  // The title keeps the node's name and address first; the time goes when the screen is narrow.
+  top.push_back(JoinParts(FitParts({{"canfleet top", 0, false, kBold},
+                                    {who_named, 0, false, kBold},
+                                    {s.device, 1},
+                                    {"(node detail)", 3},
+                                    {FormatTime(now), 2}},
+                                   width),
+                          settings.color));
+  top.push_back(Fit(Printf("NMT %s  controller %s  TEC %u  REC %u", state.c_str(),
+                           telemetry::StateName(s.controller_state), s.tec, s.rec),
                     width));
+  top.push_back(Fit(Printf("error register (1001h) %02Xh  uptime %s  status %s old", s.error_register,
+                           FormatUptime(s.uptime).c_str(), FormatAge(now - row.last_sample).c_str()),
+                    width));
+  top.push_back(Fit(Printf("heartbeat produced every %u ms (1017h)", s.heartbeat_producer_ms), width));
+  top.push_back(Fit("heartbeat consumed (1016h): " + Consumers(s), width));
   top.push_back(Fit(
-      Printf("PDO counters since the node process started: %llu RPDOs received, %llu TPDOs sent",
+      Printf("PDOs since the node process started: %llu received, %llu sent",
              static_cast<unsigned long long>(s.rpdo_count), static_cast<unsigned long long>(s.tpdo_count)),
       width));
   top.push_back("");
@@ -129,8 +136,7 @@ std::string RenderNodeDetail(const FleetView& view, const NodeKey& key, const Re
   top.push_back("");
 
   bottom.push_back(
-      Fit("1003h, the node's error history, is not telemetry: "
-          "`canfleet sdo read NODE 0x1003 1 u32` (sub 0: how many)",
+      Fit("1003h (error history) is not telemetry: canfleet sdo read NODE 0x1003 1 u32 (sub 0: how many)",
           width));
   bottom.push_back(paint(kDim, Fit(help, width)));
 

@@ -70,7 +70,7 @@ void Select(int delta, RenderSettings& settings, const FleetView& view) {
   settings.selected = MoveSelection(rows, settings.selected, delta);
   if (!settings.selected) return;
   const auto page =
-      PageOf(rows, *settings.selected, RowsPerPage(settings, static_cast<int>(view.buses().size() + 1)));
+      PageOf(rows, *settings.selected, RowsPerPage(settings, StatusLines(view, settings.filter)));
   if (page) settings.page = *page;
 }
 
@@ -197,10 +197,12 @@ void AddTopOptions(CLI::App& app, TopOptions& options) {
   telemetry::AddDdsOptions(app, options.dds);
   app.add_option("--bus", options.filter.bus, "only this bus");
   app.add_option("--state", options.filter.state,
-                 "only nodes in this state: OPER PREOP STOP INIT, active passive bus-off, fault, ok")
+                 "only nodes in this state: operational pre-operational stopped initialising, error-active "
+                 "error-passive bus-off, fault, ok")
       ->check(
           [](const std::string& s) { return IsValidStateFilter(s) ? std::string() : "unknown state " + s; });
-  app.add_option("--filter", options.filter.text, "only nodes whose 'bus #id device' contains this text");
+  app.add_option("--filter", options.filter.text,
+                 "only nodes whose 'bus #id name device' contains this text");
   app.add_option_function<std::string>(
          "--sort",
          [&options](const std::string& s) {
@@ -208,7 +210,7 @@ void AddTopOptions(CLI::App& app, TopOptions& options) {
            if (!key) throw CLI::ValidationError("--sort", "unknown sort key " + s);
            options.sort = *key;
          },
-         "node (bus, id), state, errors, change (latest first), device")
+         "node (bus, id), name, state, errors, change (latest first), device")
       ->default_str("node");
   app.add_flag("--reverse", options.reverse, "reverse the order");
   app.add_option_function<double>(
@@ -260,7 +262,9 @@ int RunTop(const TopOptions& options) {
                     .emcy = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); },
                     .io = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); },
                     .bus_stats = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); },
-                    .fault = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); }});
+                    .fault = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); },
+                    .verdict = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); },
+                    .scenario = [&](const auto& s, const auto& m) { view.Apply(s, m, nullptr); }});
 
   RenderSettings settings;
   settings.filter = options.filter;
@@ -339,7 +343,7 @@ int RunTop(const TopOptions& options) {
       // Clamp the page here so that n/p never run past the ends.
       const int pages =
           PageCount(SelectRows(view, settings.filter, settings.sort, settings.reverse, settings.now).size(),
-                    RowsPerPage(settings, static_cast<int>(view.buses().size() + 1)));
+                    RowsPerPage(settings, StatusLines(view, settings.filter)));
       if (settings.page >= pages) settings.page = options.auto_page.count() > 0 ? 0 : pages - 1;
       if (settings.page < 0) settings.page = 0;
       std::string frame = RenderFrame(view, settings);

@@ -12,7 +12,7 @@
 
 namespace canfleet::tools {
 
-enum class SortKey { kBusNode, kState, kErrors, kLastChange, kDevice };
+enum class SortKey { kBusNode, kName, kState, kErrors, kLastChange, kDevice };
 const char* ToString(SortKey key);
 std::optional<SortKey> ParseSortKey(std::string_view text);
 /// The next key in the order above (the `s` key cycles through them).
@@ -20,10 +20,12 @@ SortKey NextSortKey(SortKey key);
 
 struct TopFilter {
   std::string bus{};  ///< exact bus name; empty = all
-  /// NMT state ("OPER", "PREOP", "STOP", "INIT", case-insensitive), controller state ("active",
-  /// "passive", "bus-off"), or "fault" (IsFaulted) / "ok"; empty = all.
+  /// NMT state ("operational", "pre-operational", "stopped", "initialising", "unknown";
+  /// case-insensitive), controller state ("error-active", "error-passive", "bus-off"), or "fault"
+  /// (IsFaulted) / "ok"; empty = all. The short words of old ("OPER", "PREOP", "STOP", "INIT",
+  /// "active", "passive") still work.
   std::string state{};
-  std::string text{};  ///< case-insensitive substring of "bus #id device"; empty = all
+  std::string text{};  ///< case-insensitive substring of "bus #id name device"; empty = all
 };
 
 /// True if the filter's `state` is one of the accepted words (for command-line validation).
@@ -52,12 +54,21 @@ struct RenderSettings {
   bool detail = false;
 };
 
-/// Node rows that fit on one page of a screen of `height` lines with `bus_count` bus lines.
-int RowsPerPage(const RenderSettings& settings, int bus_count);
+/// Node rows that fit on one page of a screen of `height` lines with `status_lines` bus and
+/// scenario lines above the table.
+int RowsPerPage(const RenderSettings& settings, int status_lines);
+/// The bus and scenario lines RenderFrame shows for `view` under `filter`.
+int StatusLines(const FleetView& view, const TopFilter& filter);
 int PageCount(std::size_t rows, int rows_per_page);
 
 /// The whole screen as text, lines separated by '\n', no cursor movement (the caller clears): the
-/// table, or with `detail` and a selected node that node's detail screen (RenderNodeDetail).
+/// title, a line per bus and per scenario (its cycle, clock, verdict counts and step), the node
+/// table and the recent events (verdicts among them), or with `detail` and a selected node that
+/// node's detail screen (RenderNodeDetail). Every line fits `width`: the table shows the columns
+/// that fit, by priority (at 80: name, bus, id, NMT, controller, TEC/REC, error register,
+/// heartbeat consumers, last EMCY, age), other lines keep their most important parts or are cut
+/// at a word boundary with "...". The selected row starts with "> " (and is in reverse video in
+/// color).
 std::string RenderFrame(const FleetView& view, const RenderSettings& settings);
 
 /// The row `delta` rows after (or before) `current` among `rows`, held at the ends; the first row

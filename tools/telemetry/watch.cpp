@@ -38,8 +38,8 @@ void AddWatchOptions(CLI::App& app, WatchOptions& options) {
              options.kinds.insert(*kind);
            }
          },
-         "event types: emcy nmt controller error-register hb-consumer fault gone seen (default: all but "
-         "seen)")
+         "event types: emcy nmt controller error-register hb-consumer fault verdict gone seen (default: "
+         "all but seen)")
       ->delimiter(',');
   app.add_flag("--history", options.history,
                "also print the events from before watch started (kept by DDS, flagged [history]); default: "
@@ -74,7 +74,8 @@ int RunWatch(const WatchOptions& options) {
                     .emcy = [&](const auto& s, const auto& m) { view.Apply(s, m, &events); },
                     .io = {},
                     .bus_stats = {},
-                    .fault = [&](const auto& s, const auto& m) { view.Apply(s, m, &events); }});
+                    .fault = [&](const auto& s, const auto& m) { view.Apply(s, m, &events); },
+                    .verdict = [&](const auto& s, const auto& m) { view.Apply(s, m, &events); }});
 
   g_stop = false;
   g_reader = &reader;

@@ -78,9 +78,9 @@ TEST(CycloneConfig, AWriterStartsWithTheAnnounceOnlySettings) {
 // meeting across processes: tests/system/telemetry, "SecondTerminal").
 TEST(Participant, TheBuiltInConfigurationStartsAMonitorAndAWriter) {
   ::unsetenv("CYCLONEDDS_URI");
-  Participant monitor({.domain_id = 71, .config_file = "", .discovery = DdsDiscovery::kAll});
+  Participant monitor({.domain_id = 96, .config_file = "", .discovery = DdsDiscovery::kAll});
   EXPECT_GT(monitor.handle(), 0);
-  Participant writer({.domain_id = 72, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly});
+  Participant writer({.domain_id = 97, .config_file = "", .discovery = DdsDiscovery::kMonitorsOnly});
   EXPECT_GT(writer.handle(), 0);
 }
 

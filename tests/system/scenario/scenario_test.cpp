@@ -137,9 +137,12 @@ TEST(CanfleetUpScenarioTest, ARepeatingScenarioRunsAgainAndInjectsItsFaultsAgain
   ASSERT_TRUE(third_run) << log << up.Log();
   EXPECT_NE(log.find("scenario run 2: 5 step(s), 2 expectation(s)"), std::string::npos) << log;
   // Each run judged completely, on its own.
-  EXPECT_EQ(Count(log, "expect pass emcy: EMCY 8130h from quad-6"), 2u) << log;
-  EXPECT_EQ(Count(log, "expect pass scenario[4]: quad-6 operational"), 2u) << log;
-  EXPECT_EQ(Count(log, "expect fail"), 0u) << log;
+  // The log's verdicts are the lines `canfleet test` prints: "expect pass  FILE:LINE  NAME: ...".
+  EXPECT_EQ(Count(log, "expect pass  " + file + ":"), 4u) << log;
+  EXPECT_EQ(Count(log, "  emcy: EMCY 8130h from quad-6"), 2u) << log;
+  EXPECT_EQ(Count(log, "  scenario[4]: quad-6 operational"), 2u) << log;
+  EXPECT_EQ(Count(log, "expect FAIL"), 0u) << log;
+  EXPECT_EQ(Count(log, "expect skip"), 0u) << log;
   EXPECT_EQ(log.find("already active"), std::string::npos) << log;
 }
 

@@ -26,7 +26,9 @@ class Monitor {
                  .emcy = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
                  .io = {},
                  .bus_stats = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
-                 .fault = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); }}) {}
+                 .fault = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
+                 .verdict = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); },
+                 .scenario = [this](const auto& s, const auto& m) { view_.Apply(s, m, &events_); }}) {}
 
   bool Until(const std::function<bool()>& condition, std::chrono::milliseconds timeout = kPatience) {
     return WaitUntil(

@@ -86,7 +86,7 @@ class Monitor {
     std::string out = std::to_string(view_.nodes().size()) + " node(s):";
     for (const auto& [key, row] : view_.nodes()) {
       out += " " + key.bus + "#" + std::to_string(key.node_id) + "=" +
-             telemetry::ShortName(row.status.nmt_state) + (row.alive ? "" : "(gone)");
+             telemetry::StateName(row.status.nmt_state) + (row.alive ? "" : "(gone)");
     }
     return out + ", " + std::to_string(events_.size()) + " event(s)";
   }

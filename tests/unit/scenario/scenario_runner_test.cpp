@@ -67,6 +67,7 @@ class ScenarioRunnerTest : public ::testing::Test {
                                                    acted_.push_back({s.name(), scheduler_.Now()});
                                                  },
                                              .decided = [this](const Result& r) { decided_.push_back(r); },
+                                             .began = {},
                                              .done = [this] { ++done_; },
                                          });
     runner_->Start();
@@ -324,6 +325,62 @@ scenario { at_ms: 3000 clear {} }
   scheduler_.Advance(2s);
   EXPECT_EQ(done_, 1);
   EXPECT_TRUE(runner_->Done());
+}
+
+// Issue 29: what monitors show of a run (telemetry's ScenarioStatus and Verdict): the counts of this
+// run's verdicts, the step it is at (named, or what an action does), and each result's index
+// among the expectations.
+TEST_F(ScenarioRunnerTest, ProgressCountsVerdictsAndNamesTheLatestStep) {
+  Run(R"(
+scenario { at_ms: 1000 io { node: "quad-5" name: "AIN1.voltage_mV" value: "1800" } }
+scenario { at_ms: 2000 name: "cut-hb" inject { kind: HEARTBEAT_LOSS node: "quad-5" } }
+scenario { name: "emcy" expect { after: "cut-hb" within_ms: 500 emcy { node: "quad-6" code: 0x8130 } } }
+scenario { at_ms: 3000 expect { within_ms: 100 emcy { node: "quad-6" code: 0x1000 } } }
+)");
+  Progress p = runner_->GetProgress();
+  EXPECT_TRUE(p.started);
+  EXPECT_FALSE(p.done);
+  EXPECT_EQ(p.expectations, 2u);
+  EXPECT_EQ(p.pending, 2u);
+  EXPECT_EQ(p.step, "");
+  scheduler_.Advance(1s);
+  p = runner_->GetProgress();
+  EXPECT_EQ(p.step, "io quad-5 AIN1.voltage_mV=1800");
+  EXPECT_EQ(p.step_time, T(1s));
+  scheduler_.Advance(1s);
+  EXPECT_EQ(runner_->GetProgress().step, "emcy") << "the window opened by cut-hb is the latest to begin";
+  runner_->Frame("can0", Emcy(6, 0x8130), T(2100ms));
+  p = runner_->GetProgress();
+  EXPECT_EQ(p.passed, 1u);
+  EXPECT_EQ(p.pending, 1u);
+  ASSERT_EQ(decided_.size(), 1u);
+  EXPECT_EQ(decided_[0].index, 0);
+  scheduler_.Advance(1100ms);  // 3.1 s: the unnamed expectation's window closed without its EMCY
+  p = runner_->GetProgress();
+  EXPECT_EQ(p.failed, 1u);
+  EXPECT_EQ(p.pending, 0u);
+  EXPECT_TRUE(p.done);
+  EXPECT_EQ(p.step, "scenario[3]");
+  ASSERT_EQ(decided_.size(), 2u);
+  EXPECT_EQ(decided_[1].index, 1);
+  EXPECT_EQ(runner_->Results()[1].index, 1);
+}
+
+TEST(ActionText, SaysWhatAnActionDoes) {
+  const auto step = [](const std::string& text) {
+    topology::Step s;
+    EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &s)) << text;
+    return ActionText(s);
+  };
+  EXPECT_EQ(step(R"(inject { kind: HEARTBEAT_LOSS node: "quad-5" })"), "inject heartbeat-loss quad-5");
+  EXPECT_EQ(step(R"(inject { kind: PARTITION bus: "can0" })"), "inject partition can0");
+  EXPECT_EQ(step(R"(clear { label: "hb-loss" })"), "clear hb-loss");
+  EXPECT_EQ(step(R"(clear { fault_id: 3 })"), "clear 3");
+  EXPECT_EQ(step(R"(clear {})"), "clear all");
+  EXPECT_EQ(step(R"(nmt { action: NMT_START node: "quad-6" })"), "nmt start quad-6");
+  EXPECT_EQ(step(R"(io { node: "psu-34" name: "ENABLE.level" value: "low" })"), "io psu-34 ENABLE.level=low");
+  EXPECT_EQ(step(R"(sdo { node: "quad-5" index: 0x1017 subindex: 0 type: "u16" value: "1000" })"),
+            "sdo write quad-5 1017h sub 0");
 }
 
 }  // namespace

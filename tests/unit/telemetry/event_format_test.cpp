@@ -122,5 +122,74 @@ TEST(WatchFilter, BusNodeAndHistory) {
   EXPECT_FALSE(Selected(old, options));
 }
 
+FleetEvent Verdict(telemetry::VerdictResult result) {
+  return {.time = kTime,
+          .kind = EventKind::kVerdict,
+          .verdict = VerdictSample{
+              .source = "topologies/demo.textproto",
+              .index = 7,
+              .scenario = "demo",
+              .cycle = 2,
+              .result = result,
+              .name = "quad-6-emcy",
+              .line = 284,
+              .text = "FAIL  topologies/demo.textproto:284  quad-6-emcy: EMCY 8130h from quad-6 "
+                      "within 4000 ms after cut-hb: saw \"nothing\"",
+              .scenario_time_s = 44.5}};
+}
+
+// Issue 29: `canfleet watch` prints verdicts whole, with the line `canfleet test` prints.
+TEST(EventText, VerdictLineIsTheWholeResultLine) {
+  EXPECT_EQ(
+      FormatEventText(Verdict(telemetry::VerdictResult::kFail)),
+      "2023-11-14T22:13:20.123Z demo VERDICT cycle 2: FAIL  topologies/demo.textproto:284  quad-6-emcy: "
+      "EMCY 8130h from quad-6 within 4000 ms after cut-hb: saw \"nothing\"");
+  // `canfleet top`'s compact form: time of day, result, name, what was expected and seen.
+  EXPECT_EQ(
+      FormatEventText(Verdict(telemetry::VerdictResult::kFail), true),
+      "22:13:20.123 FAIL quad-6-emcy (cycle 2): EMCY 8130h from quad-6 within 4000 ms after cut-hb: saw "
+      "\"nothing\"");
+}
+
+TEST(EventJson, VerdictFields) {
+  const std::string json = FormatEventJson(Verdict(telemetry::VerdictResult::kFail));
+  EXPECT_NE(json.find(R"("type":"verdict")"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("source":"topologies/demo.textproto","index":7,"scenario":"demo","cycle":2,)"
+                      R"("result":"FAIL","name":"quad-6-emcy","line":284,)"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(R"(saw \"nothing\"","text_cut":false,"scenario_time_s":44.500)"), std::string::npos)
+      << json;
+}
+
+TEST(EventText, NodeEventsNameTheNodeAndFaultSummariesAreNeverCut) {
+  FleetEvent emcy = Emcy();
+  emcy.name = "quad-5";
+  EXPECT_EQ(FormatEventText(emcy).rfind("2023-11-14T22:13:20.123Z can0 #5 quad-5 EMCY 8130h", 0), 0u);
+  EXPECT_NE(FormatEventJson(emcy).find(R"("name":"quad-5")"), std::string::npos);
+  const std::string summary(
+      "drop of frames 0x185 from quad-5 on can0 (to quad-6, quad-7), probability 0.5 (seed 7), for 10s, "
+      "until "
+      "cleared, and then some more words to pass the 256 characters of the old bound of the buffer that "
+      "printf "
+      "used to fill, which cut a summary like this one in the middle of a word without saying so");
+  FleetEvent fault{.time = kTime,
+                   .kind = EventKind::kFault,
+                   .bus = "can0",
+                   .node_id = 5,
+                   .fault = FaultEventSample{
+                       .bus = "can0", .fault_id = 2, .kind = "drop", .parameters = {{"summary", summary}}}};
+  const std::string text = FormatEventText(fault);
+  EXPECT_NE(text.find("summary=" + summary), std::string::npos) << text;
+}
+
+TEST(WatchFilter, VerdictIsATypeOfItsOwn) {
+  EXPECT_EQ(ParseEventKind("verdict"), EventKind::kVerdict);
+  WatchOptions options;
+  options.kinds = {EventKind::kVerdict};
+  EXPECT_TRUE(Selected(Verdict(telemetry::VerdictResult::kPass), options));
+  EXPECT_FALSE(Selected(Emcy(), options));
+}
+
 }  // namespace
 }  // namespace canfleet::tools

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace canfleet::tools {
 namespace {
 
@@ -41,10 +43,11 @@ TEST(FleetView, FirstStatusIsSeenThenChangesAreEvents) {
   view.Apply(s, At(kStart + 2s), &events);
   ASSERT_EQ(events.size(), 3u);
   EXPECT_EQ(events[0].kind, EventKind::kNmt);
-  EXPECT_EQ(events[0].from, "PREOP");
-  EXPECT_EQ(events[0].to, "OPER");
+  // The words of the CLI and the expectations (issue 29): vocabulary/nmt_state, bus/bus_port.
+  EXPECT_EQ(events[0].from, "pre-operational");
+  EXPECT_EQ(events[0].to, "operational");
   EXPECT_EQ(events[1].kind, EventKind::kController);
-  EXPECT_EQ(events[1].to, "passive");
+  EXPECT_EQ(events[1].to, "error-passive");
   EXPECT_EQ(events[2].kind, EventKind::kErrorRegister);
   EXPECT_EQ(events[2].from, "00h");
   EXPECT_EQ(events[2].to, "11h");
@@ -207,6 +210,78 @@ TEST(EventKind, NamesRoundTrip) {
     EXPECT_EQ(ParseEventKind(ToString(kind)), kind);
   }
   EXPECT_EQ(ParseEventKind("nope"), std::nullopt);
+}
+
+// Issue 29: a scenario's verdicts are events of the fleet (the Verdict topic) and its status is
+// the scenario line; node events carry the node's topology name.
+TEST(FleetView, VerdictsAreEventsAndTheScenarioStatusIsKeptUntilItsFleetStops) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  const VerdictSample verdict{
+      .source = "demo.textproto",
+      .index = 3,
+      .scenario = "demo",
+      .cycle = 2,
+      .result = telemetry::VerdictResult::kFail,
+      .name = "quad-6-emcy",
+      .line = 284,
+      .text = "FAIL  demo.textproto:284  quad-6-emcy: EMCY 8130h from quad-6: saw nothing"};
+  view.Apply(verdict, At(kStart + 2s), &events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, EventKind::kVerdict);
+  ASSERT_TRUE(events[0].verdict);
+  EXPECT_EQ(events[0].verdict->name, "quad-6-emcy");
+  EXPECT_FALSE(events[0].replay);
+  EXPECT_EQ(view.recent().back().kind, EventKind::kVerdict);
+  // A dispose of the Verdict instance (the fleet stopped) is no verdict.
+  view.Apply(verdict, {.source_time = kStart + 3s, .valid_data = false, .alive = false, .disposed = true},
+             &events);
+  EXPECT_EQ(events.size(), 1u);
+
+  telemetry::ScenarioStatusSample status{.source = "demo.textproto",
+                                         .scenario = "demo",
+                                         .cycle = 2,
+                                         .running = true,
+                                         .passed = 4,
+                                         .failed = 1,
+                                         .pending = 3};
+  view.Apply(status, At(kStart + 2s), &events);
+  ASSERT_EQ(view.scenarios().size(), 1u);
+  EXPECT_EQ(view.scenarios().at("demo.textproto").status.failed, 1);
+  EXPECT_EQ(events.size(), 1u) << "a status is no event";
+  view.Apply(status, {.source_time = kStart + 4s, .valid_data = false, .alive = false, .disposed = true},
+             &events);
+  EXPECT_TRUE(view.scenarios().empty());
+}
+
+TEST(FleetView, NodeEventsCarryTheNodesName) {
+  FleetView view(kStart);
+  std::vector<FleetEvent> events;
+  NodeStatusSample s = Status(6);
+  s.name = "quad-6";
+  view.Apply(s, At(kStart + 1s), &events);
+  view.Apply(EmcySample{.bus = "can0", .node_id = 6, .emcy = {.code = 0x8130}}, At(kStart + 2s), &events);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].kind, EventKind::kEmcy);
+  EXPECT_EQ(events[1].name, "quad-6");
+  // An EMCY taken before its node's first status is named once the status arrives.
+  view.Apply(EmcySample{.bus = "can0", .node_id = 7, .emcy = {.code = 0x8130}}, At(kStart + 3s), nullptr);
+  NodeStatusSample seven = Status(7);
+  seven.name = "quad-7";
+  view.Apply(seven, At(kStart + 3s), nullptr);
+  const auto emcy = std::find_if(view.recent().begin(), view.recent().end(), [](const FleetEvent& e) {
+    return e.kind == EventKind::kEmcy && e.node_id == 7;
+  });
+  ASSERT_NE(emcy, view.recent().end());
+  EXPECT_EQ(emcy->name, "quad-7");
+}
+
+TEST(FleetView, AScenarioWithoutNewsIsStale) {
+  FleetView view(kStart);
+  view.Apply(telemetry::ScenarioStatusSample{.source = "a", .publish_period = 1s}, At(kStart), nullptr);
+  const ScenarioRow& row = view.scenarios().at("a");
+  EXPECT_FALSE(IsStale(row, kStart + 2s));
+  EXPECT_TRUE(IsStale(row, kStart + 4s));
 }
 
 }  // namespace

@@ -130,5 +130,36 @@ TEST(PublisherPacing, OrchestratorBusStatsArePacedPerBus) {
   EXPECT_EQ(telemetry.stats().event_writes, 1u);
 }
 
+// Issue 29: a verdict goes out at once, after the status it changed (inside the sampling window
+// too); the scenario's clock alone waits for the period.
+TEST(PublisherPacing, AVerdictGoesOutAtOnceWithItsScenarioStatus) {
+  Participant participant(Dds(8));
+  SimulatedScheduler scheduler;
+  OrchestratorTelemetry telemetry(participant, {.period = 1s, .min_interval = 20ms}, scheduler);
+  ScenarioStatusSnapshot status{.source = "demo.textproto",
+                                .scenario = "demo",
+                                .cycle = 1,
+                                .running = true,
+                                .expectations = 2,
+                                .pending = 2};
+  telemetry.UpdateScenario(status);
+  scheduler.Advance(0ms);
+  ASSERT_EQ(telemetry.stats().state_writes, 1u);
+  status.scenario_time_s = 0.5;  // the clock alone: no write before the period
+  telemetry.UpdateScenario(status);
+  scheduler.Advance(500ms);
+  EXPECT_EQ(telemetry.stats().state_writes, 1u);
+  status.passed = 1;
+  status.pending = 1;
+  telemetry.UpdateScenario(status);
+  telemetry.PublishVerdict({.source = "demo.textproto", .index = 0, .scenario = "demo", .text = "pass  x"});
+  scheduler.Advance(0ms);
+  EXPECT_EQ(telemetry.stats().event_writes, 1u);
+  EXPECT_EQ(telemetry.stats().state_writes, 2u) << "the counts that include the verdict, with it";
+  telemetry.RemoveScenario("demo.textproto");
+  scheduler.Advance(0ms);
+  EXPECT_EQ(telemetry.stats().write_errors, 0u);
+}
+
 }  // namespace
 }  // namespace canfleet::telemetry

@@ -96,7 +96,9 @@ TEST_F(TopFormat, FiltersByBusStateAndText) {
 }
 
 TEST_F(TopFormat, StateFilterWordsAreValidated) {
-  EXPECT_TRUE(IsValidStateFilter("OPER"));
+  EXPECT_TRUE(IsValidStateFilter("pre-operational"));
+  EXPECT_TRUE(IsValidStateFilter("error-passive"));
+  EXPECT_TRUE(IsValidStateFilter("OPER"));  // the short words of old still work
   EXPECT_TRUE(IsValidStateFilter("bus-off"));
   EXPECT_TRUE(IsValidStateFilter(""));
   EXPECT_FALSE(IsValidStateFilter("running"));
@@ -107,11 +109,16 @@ TEST_F(TopFormat, PlainFrameHasNoEscapesAndOneLinePerNode) {
   const std::string frame = RenderFrame(view_, settings);
   EXPECT_EQ(frame.find('\x1b'), std::string::npos);
   const auto lines = Lines(frame);
-  EXPECT_NE(lines[0].find("4 nodes on 2 buses, 1 faulted, 4 shown"), std::string::npos);
-  const auto count = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
+  EXPECT_NE(lines[0].find("4 nodes on 2 buses, 1 faulted"), std::string::npos);
+  const auto buses = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
     return l.rfind("can0 ", 0) == 0 || l.rfind("can1 ", 0) == 0;
   });
-  EXPECT_EQ(count, 4 + 2);  // node rows and bus lines
+  EXPECT_EQ(buses, 2);
+  const auto rows = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.rfind("  ", 0) == 0 &&
+           (l.find(" can0 ") != std::string::npos || l.find(" can1 ") != std::string::npos);
+  });
+  EXPECT_EQ(rows, 4);
   EXPECT_NE(frame.find("bus-off"), std::string::npos);
   EXPECT_NE(frame.find("1:02:03"), std::string::npos);  // uptime 3723 s
 }
@@ -119,14 +126,14 @@ TEST_F(TopFormat, PlainFrameHasNoEscapesAndOneLinePerNode) {
 TEST_F(TopFormat, ColorFrameMarksFaultsRedAndFreshChangesReversed) {
   RenderSettings settings{.color = true, .now = kNow};
   const auto lines = Lines(RenderFrame(view_, settings));
-  const auto row = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
-    return l.find("can1       2") != std::string::npos;
-  });
+  const auto row = std::find_if(lines.begin(), lines.end(),
+                                [](const std::string& l) { return l.find("can1  2") != std::string::npos; });
   ASSERT_NE(row, lines.end());
   EXPECT_NE(row->find("\x1b[31m"), std::string::npos);  // red: bus-off
-  EXPECT_NE(row->find("\x1b[7m"), std::string::npos);   // reversed: changed within 5 s
+  EXPECT_NE(row->find("\x1b[1m"), std::string::npos);   // bold: changed within 5 s
+  EXPECT_EQ(row->find("\x1b[7m"), std::string::npos);   // reverse video is the selection's alone
   const auto quiet = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
-    return l.find("can0       3") != std::string::npos;
+    return l.find("can0  3") != std::string::npos;
   });
   ASSERT_NE(quiet, lines.end());
   EXPECT_EQ(quiet->find('\x1b'), std::string::npos);  // healthy and quiet: plain
@@ -146,17 +153,32 @@ TEST_F(TopFormat, ArrowKeysMoveTheSelectionWithinTheShownRowsAndItIsMarked) {
   EXPECT_EQ(PageOf(rows, {"can1", 2}, 2), 1);
   EXPECT_FALSE(PageOf(rows, {"can9", 1}, 2));
 
-  RenderSettings settings{.color = false, .now = kNow, .selected = NodeKey{"can0", 3}};
-  const auto lines = Lines(RenderFrame(view_, settings));
-  const auto marked = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
-    return l.size() > 2 && l.compare(l.size() - 2, 2, " <") == 0;
-  });
+  // Without colors the selected row starts with "> " (issue 29: a trailing "<" was cut off at 80
+  // columns); every other row starts with two blanks.
+  RenderSettings settings{.width = 80, .color = false, .now = kNow, .selected = NodeKey{"can0", 3}};
+  auto lines = Lines(RenderFrame(view_, settings));
+  const auto marked =
+      std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("> ", 0) == 0; });
   EXPECT_EQ(marked, 1);
-  const auto row = std::find_if(lines.begin(), lines.end(),
-                                [](const std::string& l) { return l.rfind("can0       3", 0) == 0; });
+  const auto row =
+      std::find_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("> ", 0) == 0; });
   ASSERT_NE(row, lines.end());
-  EXPECT_EQ(row->substr(row->size() - 2), " <");
-  EXPECT_NE(lines.back().find("Enter node detail"), std::string::npos);  // the help line says how
+  EXPECT_NE(row->find("can0  3"), std::string::npos) << *row;
+  EXPECT_NE(lines.back().find("Enter detail"), std::string::npos);  // the help line says how
+
+  // In color it is in reverse video as well, across the whole width (not only underlined).
+  settings.color = true;
+  lines = Lines(RenderFrame(view_, settings));
+  const auto colored = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find("> ") != std::string::npos && l.find("can0  3") != std::string::npos;
+  });
+  ASSERT_NE(colored, lines.end());
+  EXPECT_NE(colored->find("\x1b[7m"), std::string::npos);
+  EXPECT_EQ(colored->find("\x1b[4m"), std::string::npos);
+  const auto others = std::count_if(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find("\x1b[7m") != std::string::npos;
+  });
+  EXPECT_EQ(others, 1);
 }
 
 class NodeDetail : public TopFormat {
@@ -193,8 +215,8 @@ TEST_F(NodeDetail, ShowsStatusCountersIoWithUnitsAndTheEmcysTheBusSawNewestFirst
   EXPECT_EQ(frame.find('\x1b'), std::string::npos);
   EXPECT_NE(frame.find("can0 #6  quad-controller"), std::string::npos);
   EXPECT_NE(frame.find("error register (1001h) 01h"), std::string::npos);
-  EXPECT_NE(frame.find("#5 timed-out (1500 ms, last OPER)"), std::string::npos);
-  EXPECT_NE(frame.find("378 RPDOs received, 1512 TPDOs sent"), std::string::npos);
+  EXPECT_NE(frame.find("#5 timed-out (1500 ms, last operational)"), std::string::npos);
+  EXPECT_NE(frame.find("378 received, 1512 sent"), std::string::npos);
   EXPECT_NE(frame.find("SIMULATED INPUTS (2)"), std::string::npos);
   EXPECT_NE(frame.find("SIMULATED OUTPUTS (3)"), std::string::npos);
   const auto lines = Lines(frame);
@@ -256,7 +278,7 @@ TEST(TopPaging, A127NodeBusPagesWithinTheScreen) {
   for (std::uint8_t id = 1; id <= 127; ++id)
     view.Apply(Status("can0", id), At(kNow - 1s), nullptr);
   RenderSettings settings{.width = 120, .height = 40, .color = false, .now = kNow};
-  const int per_page = RowsPerPage(settings, 1);
+  const int per_page = RowsPerPage(settings, StatusLines(view, {}));
   const int pages = PageCount(127, per_page);
   EXPECT_EQ(pages, (127 + per_page - 1) / per_page);
   std::set<std::string> seen;
@@ -266,8 +288,8 @@ TEST(TopPaging, A127NodeBusPagesWithinTheScreen) {
     EXPECT_LE(static_cast<int>(lines.size()), settings.height);
     for (const auto& line : lines) {
       EXPECT_LE(static_cast<int>(line.size()), settings.width);
-      if (line.rfind("can0 ", 0) == 0 && line.find("nodes 127") == std::string::npos)
-        seen.insert(line.substr(0, 13));
+      if (line.find(" can0 ") != std::string::npos && line.find("nodes 127") == std::string::npos)
+        seen.insert(line.substr(0, 24));
     }
   }
   EXPECT_EQ(seen.size(), 127u);  // every node on exactly one page
@@ -295,12 +317,12 @@ TEST(TopText, UptimeAndAgeFormats) {
 TEST(TopText, SortKeysCycleAndParse) {
   SortKey key = SortKey::kBusNode;
   std::set<SortKey> seen;
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < 6; ++i) {
     seen.insert(key);
     EXPECT_EQ(ParseSortKey(ToString(key)), key);
     key = NextSortKey(key);
   }
-  EXPECT_EQ(seen.size(), 5u);
+  EXPECT_EQ(seen.size(), 6u);
   EXPECT_EQ(key, SortKey::kBusNode);
 }
 
