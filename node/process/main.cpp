@@ -178,8 +178,11 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   for (std::size_t p = 0; p < port_count; ++p) {
     auto* client = dynamic_cast<BrokerClientPort*>(ports[p].get());
     if (client == nullptr) continue;
-    client->OnNodeRequest(
-        [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
+    client->OnNodeRequest([&node, &log](const wire::NodeRequest& r) {
+      wire::NodeReply reply = node::AnswerNodeRequest(node->io(), r);
+      if (!reply.notice().empty()) log->warn("simulated I/O: {}", reply.notice());
+      return reply;
+    });
     // The broker wakes the node only for frames its stack listens to (an acceptance filter).
     client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
   }
@@ -188,6 +191,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     if (eq == std::string::npos) throw std::invalid_argument("--io " + assignment + ": expected NAME=VALUE");
     auto status = node->io().SetText(assignment.substr(0, eq), assignment.substr(eq + 1));
     if (!status.ok()) throw std::invalid_argument("--io " + assignment + ": " + status.error);
+    if (!status.notice.empty()) log->warn("--io {}: {}", assignment, status.notice);
   }
 
   std::unique_ptr<node::StdinControl> control;

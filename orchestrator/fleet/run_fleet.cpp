@@ -72,6 +72,8 @@ int RunFleet(const UpOptions& options) {
     std::cerr << "canfleet up: " << e.what() << "\n";
     return 2;
   }
+  for (const auto& warning : loaded.warnings)
+    std::cerr << warning << '\n';
   auto& spec = loaded.spec;
   if (options.control) spec.mutable_orchestrator()->set_control(*options.control);
   if (options.listen) {

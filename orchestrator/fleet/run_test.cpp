@@ -83,6 +83,8 @@ class FileRun {
     }
     report_.topology = loaded.spec.name();
     lines_ = loaded.step_lines;
+    for (const auto& warning : loaded.warnings)
+      std::cerr << warning << '\n';
     MakePrivate(loaded.spec, root_);
     fs::create_directories(root_);
     auto logger = std::make_shared<spdlog::logger>(

@@ -8,6 +8,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace canfleet::topology::detail {
 
@@ -43,8 +44,10 @@ class FirstErrorCollector final : public pb::io::ErrorCollector {
 /// error.
 class Scope {
  public:
-  Scope(const std::string* file, const pb::Message* message, const Tree* tree, std::string path, Loc loc)
-      : file_(file), message_(message), tree_(tree), path_(std::move(path)), loc_(loc) {}
+  /// @param warnings where Warn appends (null: warnings are dropped)
+  Scope(const std::string* file, const pb::Message* message, const Tree* tree, std::string path, Loc loc,
+        std::vector<std::string>* warnings = nullptr)
+      : file_(file), message_(message), tree_(tree), path_(std::move(path)), loc_(loc), warnings_(warnings) {}
 
   Loc loc() const { return loc_; }
   const std::string& path() const { return path_; }
@@ -65,6 +68,9 @@ class Scope {
   }
   /// An error about the message as a whole (a missing field is named by the caller's reason).
   [[noreturn]] void FailHere(std::string reason) const;
+  /// Accepts the file but says something about it: "FILE:LINE:COL: PATH.field: warning: reason"
+  /// (LoadedTopology::warnings), e.g. an old signal name.
+  void Warn(std::string_view field, std::string reason) const;
 
  private:
   const pb::FieldDescriptor* Field(std::string_view name) const;
@@ -74,6 +80,7 @@ class Scope {
   const Tree* tree_;
   std::string path_;
   Loc loc_;
+  std::vector<std::string>* warnings_;
 };
 
 }  // namespace canfleet::topology::detail

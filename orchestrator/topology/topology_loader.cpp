@@ -48,7 +48,8 @@ class Loader {
 
   LoadedTopology Run(std::string_view text) {
     Parse(text);
-    const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1});
+    std::vector<std::string> warnings;
+    const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1}, &warnings);
     CheckTopology(root);
     CheckOrchestrator(root);
     CheckTime(root);
@@ -61,7 +62,7 @@ class Loader {
     std::vector<int> step_lines;
     for (int i = 0; i < spec_.scenario_size(); ++i)
       step_lines.push_back(root.Child("scenario", spec_.scenario(i), i).loc().line);
-    return LoadedTopology{std::move(spec_), file_, std::move(step_lines)};
+    return LoadedTopology{std::move(spec_), file_, std::move(step_lines), std::move(warnings)};
   }
 
  private:

@@ -56,6 +56,10 @@ struct LoadedTopology {
   Topology spec;
   std::filesystem::path file;
   std::vector<int> step_lines;  ///< the line of each scenario step (1-based), for reports
+  /// What the file may want to change though it loads: "FILE:LINE:COL: FIELD: warning: reason",
+  /// e.g. an old signal name ("IN1.voltage_mV is deprecated: use IN1.voltage_mV"). `canfleet
+  /// check`, `up` and `test` print them.
+  std::vector<std::string> warnings;
 };
 
 /// Reads, parses, validates and completes a topology file. Relative paths inside it are relative

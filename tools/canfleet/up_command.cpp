@@ -57,6 +57,8 @@ std::string Plural(int n, const char* one, const char* many) {
 int RunCheck(const std::string& file) {
   try {
     const topology::LoadedTopology loaded = topology::LoadTopology(file);
+    for (const auto& warning : loaded.warnings)
+      std::cerr << warning << '\n';
     int expectations = 0;
     for (const auto& step : loaded.spec.scenario())
       expectations += step.has_expect() ? 1 : 0;

@@ -75,8 +75,8 @@ class FakeFleet {
       options.node_id = node->id;
       options.device = device;
       if (io) {
-        options.inputs = {{"AIN1.voltage_V", "V"}, {"TC1.temperature_C", "C"}};
-        options.outputs = {{"POUT1.current_mA", "mA"}, {"DOUT1.on", ""}};
+        options.inputs = {{"IN1.voltage_mV", "mV"}, {"TC1.temperature_C", "C"}};
+        options.outputs = {{"OUT1.current_mA", "mA"}, {"OUT5.on", ""}};
       }
       node->status.nmt_state = NmtState::kOperational;
       node->status.heartbeat_producer_ms = 100;

@@ -517,30 +517,30 @@ TEST_F(CanfleetCli, IoSetAndGet) {
     Response r;
     *r.mutable_io() = Parse<IoValues>(R"pb(
       node: "quad-5"
-      values { name: "AIN1.voltage_mV" value: "2500" unit: "mV" input: true }
-      values { name: "POUT1.current_mA" value: "0" unit: "mA" })pb");
+      values { name: "IN1.voltage_mV" value: "2500" unit: "mV" input: true }
+      values { name: "OUT1.current_mA" value: "0" unit: "mA" })pb");
     if (!request.io_get().name().empty()) r.mutable_io()->mutable_values()->DeleteSubrange(1, 1);
     return r;
   });
-  Outcome run = Canfleet({"io", "set", "quad-5", "AIN1.voltage_mV", "2500"});
+  Outcome run = Canfleet({"io", "set", "quad-5", "IN1.voltage_mV", "2500"});
   EXPECT_EQ(run.exit, 0) << run.err;
-  EXPECT_EQ(run.out, "quad-5 AIN1.voltage_mV = 2500\n");
+  EXPECT_EQ(run.out, "quad-5 IN1.voltage_mV = 2500\n");
   EXPECT_TRUE(Same(handler_.Requests().back().io_set(),
-                   Parse<IoSet>("node: 'quad-5' name: 'AIN1.voltage_mV' value: '2500'")));
+                   Parse<IoSet>("node: 'quad-5' name: 'IN1.voltage_mV' value: '2500'")));
 
   run = Canfleet({"io", "get", "quad-5"});
   EXPECT_EQ(run.out,
-            "SIGNAL            VALUE  UNIT  DIRECTION\n"
-            "AIN1.voltage_mV    2500  mV    input\n"
-            "POUT1.current_mA      0  mA    output\n");
-  run = Canfleet({"io", "get", "quad-5", "AIN1.voltage_mV"});
+            "SIGNAL           VALUE  UNIT  DIRECTION\n"
+            "IN1.voltage_mV    2500  mV    input\n"
+            "OUT1.current_mA      0  mA    output\n");
+  run = Canfleet({"io", "get", "quad-5", "IN1.voltage_mV"});
   EXPECT_EQ(run.out, "2500\n") << "one signal: its value alone";
   EXPECT_TRUE(
-      Same(handler_.Requests().back().io_get(), Parse<IoGet>("node: 'quad-5' name: 'AIN1.voltage_mV'")));
+      Same(handler_.Requests().back().io_get(), Parse<IoGet>("node: 'quad-5' name: 'IN1.voltage_mV'")));
   run = Canfleet({"io", "get", "quad-5", "--json"});
   IoValues parsed;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.out, &parsed).ok()) << run.out;
-  EXPECT_EQ(parsed.values(0).name(), "AIN1.voltage_mV");
+  EXPECT_EQ(parsed.values(0).name(), "IN1.voltage_mV");
 }
 
 TEST_F(CanfleetCli, SdoReadSendsTheAddressAndPrintsTheValue) {
@@ -665,9 +665,9 @@ TEST_F(CanfleetCli, DumpJsonPrintsOneFramePerLine) {
   EXPECT_EQ(run.exit, 0) << run.err;
   EXPECT_EQ(
       run.out,
-      "{\"bus\":\"can0\",\"time_ns\":\"1700000000123456000\",\"id\":389,\"extended\":false,\"remote\":false,"
+      "{\"bus\":\"can0\",\"time_ns\":1700000000123456000,\"id\":389,\"extended\":false,\"remote\":false,"
       "\"error\":false,\"data\":\"AQIDAA==\"}\n"
-      "{\"bus\":\"can0\",\"time_ns\":\"1700000000124456000\",\"id\":389,\"extended\":false,\"remote\":false,"
+      "{\"bus\":\"can0\",\"time_ns\":1700000000124456000,\"id\":389,\"extended\":false,\"remote\":false,"
       "\"error\":false,\"data\":\"AQIDAQ==\"}\n");
 }
 

@@ -72,7 +72,7 @@ class FleetFaultsTest : public ::testing::Test {
   }
   /// POUT1 of quad-6 in mA, -1 when it cannot be read.
   double Pout1() const {
-    const auto value = fleet.IoGet("quad-6", "POUT1.current_mA");
+    const auto value = fleet.IoGet("quad-6", "OUT1.current_mA");
     return value ? std::stod(*value) : -1;
   }
 
@@ -178,13 +178,13 @@ TEST_F(FleetFaultsTest, BusOffWithManualRecoveryHoldsUntilCleared) {
 }
 
 // Through the real CLI: an option bus-off does not take is refused by the orchestrator with what
-// it takes (nothing is injected); `--duration` holds the bus-off: the node's controller shows
-// bus-off with TEC > 255 for the whole time while its recovery attempts fail (ISO 11898-1:2015
-// §12.1.4.2: 1408 bit times each, 5.6 ms at 250 kbit/s, counted as the fault's hits), then it
+// it takes (nothing is injected), a bad argument (exit 2); `--duration` holds the bus-off: the node's
+// controller shows bus-off with TEC > 255 for the whole time while its recovery attempts fail (ISO
+// 11898-1:2015 §12.1.4.2: 1408 bit times each, 5.6 ms at 250 kbit/s, counted as the fault's hits), then it
 // recovers by itself.
 TEST_F(FleetFaultsTest, BusOffHeldForADurationAndOptionsThatDoNotApplyAreRefused) {
   const auto refused = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--cob-id", "0x185"});
-  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_EQ(refused.exit_code, 2);
   EXPECT_EQ(
       refused.err,
       "canfleet: --cob-id does not apply to bus-off (it takes --node, --bus, --duration, --manual-recovery, "

@@ -212,7 +212,7 @@ TEST_F(ScenarioRunnerTest, IoAndBusLoadArePolled) {
   probe_.io_value = "1000";
   probe_.load = 20;
   Run(R"(
-scenario { name: "out" expect { within_ms: 500 io { node: "quad-6" name: "POUT1.current_mA" min: 0 max: 10 } } }
+scenario { name: "out" expect { within_ms: 500 io { node: "quad-6" name: "OUT1.current_mA" min: 0 max: 10 } } }
 scenario { name: "load" expect { within_ms: 500 bus { load_below: 50 } } }
 )");
   scheduler_.Advance(300ms);
