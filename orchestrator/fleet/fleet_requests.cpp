@@ -193,6 +193,7 @@ control::Status Fleet::Status() const {
     for (std::size_t p = 0; p < node.buses.size(); ++p) {
       const std::string& bus = node.buses[p];
       auto* port = out->add_ports();
+      port->set_can("CAN" + std::to_string(out->ports_size()));
       port->set_bus(bus);
       port->set_node_id(node.node_ids[p]);
       if (auto it = ports.find({bus, node.name()}); it != ports.end()) {
@@ -244,7 +245,8 @@ void Fleet::SdoRead(const control::Request& request, std::shared_ptr<control::Re
   const auto& read = request.sdo_read();
   const FleetNode& node = NodeOrThrow(read.node());
   if (read.port() >= node.buses.size())
-    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(read.port()));
+    throw std::invalid_argument("node '" + node.name() + "' has no CAN" + std::to_string(read.port() + 1) +
+                                " (it has " + std::to_string(node.buses.size()) + " CAN port(s))");
   if (read.index() > 0xFFFF || read.subindex() > 0xFF)
     throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
   if (!read.type().empty()) control::RequireSdoType(read.type());  // refuse an unknown type before the bus
@@ -271,7 +273,8 @@ void Fleet::SdoRead(const control::Request& request, std::shared_ptr<control::Re
 void Fleet::SdoWrite(const control::SdoWrite& write, std::function<void(std::string error)> done) {
   const FleetNode& node = NodeOrThrow(write.node());
   if (write.port() >= node.buses.size())
-    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(write.port()));
+    throw std::invalid_argument("node '" + node.name() + "' has no CAN" + std::to_string(write.port() + 1) +
+                                " (it has " + std::to_string(node.buses.size()) + " CAN port(s))");
   if (write.index() > 0xFFFF || write.subindex() > 0xFF)
     throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
   auto data = control::EncodeSdoValue(write.type(), write.value());

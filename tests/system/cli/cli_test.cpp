@@ -284,6 +284,7 @@ TEST_F(CanfleetCli, StatusJsonIsTheStatusMessage) {
   EXPECT_TRUE(Same(parsed, status)) << run.out;
   EXPECT_NE(run.out.find("\"load_percent\": 12.5"), std::string::npos) << "field names as in the .proto";
   EXPECT_NE(run.out.find("\"error_frames_per_s\": 0"), std::string::npos) << "zero fields are printed too";
+  EXPECT_NE(run.out.find("\"frames\": 10234,"), std::string::npos) << "64-bit counters are JSON numbers";
 }
 
 TEST_F(CanfleetCli, AnOrchestratorErrorExitsWithOneAndItsMessage) {
@@ -347,7 +348,14 @@ TEST_F(CanfleetCli, BadArgumentsExitWithTwoAndSendNothing) {
       {"--timeout", "5", "status"},
       {"nmt", "jump"},
       {"fault", "inject", "kill", "quad-5", "--node", "quad-6"},
+      {"fault", "inject", "bus-of", "quad-5"},
       {"dump", "can0", "--bus", "can1"},
+      {"sdo", "read", "datalogger", "0x1017", "0", "--port", "0"},
+      {"sdo", "read", "datalogger", "0x1017", "0", "--port", "CAN0"},
+      {"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "two"},
+      {"io", "set", "quad-5", "IN1.voltage_mV"},
+      {"io", "get"},
+      {"status", "--jsn"},
   };
   for (const auto& args : kBad) {
     std::string joined;
@@ -372,6 +380,54 @@ TEST_F(CanfleetCli, BadArgumentMessagesSayWhatToWrite) {
       << run.err;
   run = Canfleet({"fault", "clear"});
   EXPECT_NE(run.err.find("say which fault: an ID, --label LABEL or --all"), std::string::npos) << run.err;
+}
+
+// The ports as the manuals print them (CAN1, CAN2): 0 used to be the first port and is refused
+// with the reason rather than guessed.
+TEST_F(CanfleetCli, PortsAreCan1AndCan2AndZeroIsRefusedWithTheReason) {
+  const Outcome run = Canfleet({"sdo", "read", "datalogger", "0x1017", "0", "--port", "0"});
+  EXPECT_EQ(run.exit, 2);
+  EXPECT_NE(run.err.find("ports are numbered as the manuals print them, CAN1 and CAN2"), std::string::npos)
+      << run.err;
+  handler_.SetAnswer([](const Request&) { return Done("written"); });
+  EXPECT_EQ(Canfleet({"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "2"}).exit, 0);
+  EXPECT_EQ(handler_.Requests().back().sdo_write().port(), 1u);
+  EXPECT_EQ(Canfleet({"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "CAN1"}).exit, 0);
+  EXPECT_EQ(handler_.Requests().back().sdo_write().port(), 0u);
+}
+
+// What the orchestrator refuses as a bad request (an unknown node or signal, a value a signal
+// refuses, a fault without what its kind needs) is a bad argument too: exit 2, its message (with
+// the nearest names) on stderr. A failure of the fleet stays exit 1 (above).
+TEST_F(CanfleetCli, ABadRequestTheOrchestratorRefusesExitsWithTwo) {
+  handler_.SetAnswer([](const Request&) {
+    Response r = Error(
+        "no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV; all: canfleet io get "
+        "quad-5");
+    r.set_bad_request(true);
+    return r;
+  });
+  const Outcome run = Canfleet({"io", "set", "quad-5", "IN9.voltage_mV", "1"});
+  EXPECT_EQ(run.exit, 2);
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(
+      run.err,
+      "canfleet: no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV; all: canfleet "
+      "io get quad-5\n");
+}
+
+// A done request with a notice (an old signal name, a quantity the pin's configuration does not
+// read): done (exit 0, the usual line on stdout), the notice on stderr.
+TEST_F(CanfleetCli, ANoticeGoesToStderrAndTheCommandSucceeds) {
+  handler_.SetAnswer([](const Request&) {
+    Response r = Done("quad-5 AIN1.voltage_mV = 1800");
+    r.set_notice("AIN1.voltage_mV is deprecated: use IN1.voltage_mV");
+    return r;
+  });
+  const Outcome run = Canfleet({"io", "set", "quad-5", "AIN1.voltage_mV", "1800"});
+  EXPECT_EQ(run.exit, 0) << run.err;
+  EXPECT_EQ(run.out, "quad-5 AIN1.voltage_mV = 1800\n");
+  EXPECT_EQ(run.err, "canfleet: notice: AIN1.voltage_mV is deprecated: use IN1.voltage_mV\n");
 }
 
 TEST_F(CanfleetCli, HelpAndVersionExitWithZero) {
@@ -556,7 +612,7 @@ TEST_F(CanfleetCli, SdoReadSendsTheAddressAndPrintsTheValue) {
   EXPECT_TRUE(Same(handler_.Requests().back().sdo_read(),
                    Parse<SdoRead>("node: 'quad-5' index: 0x1017 subindex: 0 type: 'u16'")));
 
-  run = Canfleet({"sdo", "read", "psu-1", "1018h", "0x04", "--block", "--port", "1"});
+  run = Canfleet({"sdo", "read", "psu-1", "1018h", "0x04", "--block", "--port", "CAN2"});
   EXPECT_EQ(run.out, "E8 03\n") << "without a type: the bytes in hex";
   EXPECT_TRUE(Same(handler_.Requests().back().sdo_read(),
                    Parse<SdoRead>("node: 'psu-1' index: 0x1018 subindex: 4 block: true port: 1")));

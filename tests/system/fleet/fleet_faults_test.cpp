@@ -190,6 +190,22 @@ TEST_F(FleetFaultsTest, BusOffHeldForADurationAndOptionsThatDoNotApplyAreRefused
       "canfleet: --cob-id does not apply to bus-off (it takes --node, --bus, --duration, --manual-recovery, "
       "--label)\n");
   EXPECT_EQ(fleet.Node(fleet.Status(), "quad-6")->controller(), "error-active");
+  // A kind without what it needs, an unknown node, an unknown signal: bad arguments too, each
+  // with what would be valid (fault_kinds.cpp; the nearest names).
+  const auto no_cob_id = fleet.Cli({"fault", "inject", "rpdo-timeout", "--node", "quad-6"});
+  EXPECT_EQ(no_cob_id.exit_code, 2) << no_cob_id.err;
+  EXPECT_NE(no_cob_id.err.find("--cob-id"), std::string::npos) << no_cob_id.err;
+  const auto no_node = fleet.Cli({"io", "get", "quad-9"});
+  EXPECT_EQ(no_node.exit_code, 2);
+  EXPECT_EQ(
+      no_node.err,
+      "canfleet: no node called 'quad-9' in this fleet; nearest: quad-5, quad-6; all: canfleet status\n");
+  const auto no_signal = fleet.Cli({"io", "get", "quad-5", "IN9.voltage_mV"});
+  EXPECT_EQ(no_signal.exit_code, 2);
+  EXPECT_EQ(no_signal.err,
+            "canfleet: no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV, "
+            "IN3.voltage_mV; "
+            "all: canfleet io get quad-5\n");
 
   const auto injected = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--duration", "2s"});
   ASSERT_EQ(injected.exit_code, 0) << injected.err;
