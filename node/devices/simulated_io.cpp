@@ -221,7 +221,21 @@ void SimulatedIo::Store(IoSignal& signal, IoValue value) {
   }
 }
 
+void SimulatedIo::LoadAliases() const {
+  if (alias_table_ == nullptr) return;
+  auto* table = alias_table_;
+  alias_table_ = nullptr;
+  for (IoAlias& alias : table())
+    const_cast<SimulatedIo*>(this)->AddAlias(std::move(alias));
+}
+
+const std::vector<std::unique_ptr<IoAlias>>& SimulatedIo::Aliases() const {
+  LoadAliases();
+  return aliases_;
+}
+
 void SimulatedIo::AddAlias(IoAlias alias) {
+  LoadAliases();
   const IoSignal* target = Find(alias.new_name);
   if (target == nullptr)
     throw std::logic_error("simulated I/O: alias of an unknown signal " + alias.new_name);
@@ -252,6 +266,7 @@ IoName SimulatedIo::Resolve(std::string_view name) const {
     out.signal = signal;
     return out;
   }
+  LoadAliases();
   if (auto it = alias_by_name_.find(name); it != alias_by_name_.end()) {
     out.alias = it->second;
     out.signal = Find(out.alias->new_name);

@@ -156,6 +156,9 @@ class SimulatedIo {
   /// Declares an old name of a declared signal. A programming error (unknown new name, a name taken,
   /// a factor on a non-number) throws std::logic_error.
   void AddAlias(IoAlias alias);
+  /// The product's alias table, added (AddAlias) the first time a name is not a current one: an
+  /// idle node that is only ever asked current names never holds the table (bench/idle).
+  void SetAliasTable(std::vector<IoAlias> (*table)()) { alias_table_ = table; }
   /// The device's word on inputs its present configuration does not read: the hook returns why
   /// (one line naming the objects that decide), or "" when `input` is read. Called after each set.
   void SetIgnoredHook(std::function<std::string(const IoSignal& input)> hook) {
@@ -182,7 +185,7 @@ class SimulatedIo {
   /// A current or an old name; an unknown one gets the nearest names in `error`.
   IoName Resolve(std::string_view name) const;
   /// Every alias, in declaration order.
-  const std::vector<std::unique_ptr<IoAlias>>& Aliases() const { return aliases_; }
+  const std::vector<std::unique_ptr<IoAlias>>& Aliases() const;
   /// Typed reads for tests. Throw std::out_of_range for an unknown name (a typo in a test should
   /// fail loudly).
   double Number(std::string_view name) const;
@@ -205,8 +208,12 @@ class SimulatedIo {
   void NoticeIgnored(const IoSignal& signal, IoStatus& status) const;
 
   std::vector<std::unique_ptr<IoSignal>> signals_;
-  std::vector<std::unique_ptr<IoAlias>> aliases_;
-  std::map<std::string, const IoAlias*, std::less<>> alias_by_name_;
+  /// Adds the alias table if it was not yet (const: it changes no signal, only what names resolve).
+  void LoadAliases() const;
+
+  mutable std::vector<std::unique_ptr<IoAlias>> aliases_;
+  mutable std::map<std::string, const IoAlias*, std::less<>> alias_by_name_;
+  mutable std::vector<IoAlias> (*alias_table_)() = nullptr;
   std::function<std::string(const IoSignal&)> ignored_hook_;
   std::map<std::string, IoSignal*, std::less<>> by_name_;
   std::map<std::size_t, Listener> listeners_;

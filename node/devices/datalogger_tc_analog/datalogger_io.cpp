@@ -38,8 +38,7 @@ DataLoggerIo::DataLoggerIo(SimulatedIo& sim) : io(sim) {
   supply = &io.AddInput(NumberSpec("VPS.voltage_mV", "mV", 0, 70000, 24000, "supply voltage"));
   cpu_temperature =
       &io.AddInput(NumberSpec("TEMP.temperature_C", "C", -50, 150, 35, "processor temperature"));
-  for (const IoAlias& alias : DataLoggerSignalAliases())
-    io.AddAlias(alias);
+  io.SetAliasTable(&DataLoggerSignalAliases);
 }
 
 std::vector<IoAlias> DataLoggerSignalAliases() {

@@ -49,8 +49,7 @@ EncoderIo::EncoderIo(SimulatedIo& sim) : io(sim) {
     hotshot[i] = &io.AddOutput(BoolSpec(ch + ".hotshot", false, ch + " in its hotshot phase"));
     tripped[i] = &io.AddOutput(BoolSpec(ch + ".tripped", false, ch + " off by its short-circuit protection"));
   }
-  for (const IoAlias& alias : EncoderSignalAliases())
-    io.AddAlias(alias);
+  io.SetAliasTable(&EncoderSignalAliases);
 }
 
 std::vector<IoAlias> EncoderSignalAliases() {

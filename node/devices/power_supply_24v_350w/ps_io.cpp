@@ -38,8 +38,7 @@ PsIo::PsIo(SimulatedIo& sim) : io(sim) {
   commanded_on =
       &io.AddOutput(BoolSpec("PS.commanded_on", false, "the output command after source selection"));
   asleep = &io.AddOutput(BoolSpec("PS.asleep", false, "the controller sleeps (manual 1.2.2)"));
-  for (const IoAlias& alias : PsSignalAliases())
-    io.AddAlias(alias);
+  io.SetAliasTable(&PsSignalAliases);
 }
 
 std::string PsIo::IgnoredInput(const IoSignal& input) const {

@@ -65,8 +65,7 @@ QuadIo::QuadIo(SimulatedIo& sim) : io(sim) {
   }
   dout_on = &io.AddOutput(BoolSpec(Out(kDout + 1) + ".on", false, "OUT5 (DOUT) driver on"));
 
-  for (const IoAlias& alias : QuadSignalAliases())
-    io.AddAlias(alias);
+  io.SetAliasTable(&QuadSignalAliases);
 }
 
 std::vector<IoAlias> QuadSignalAliases() {

@@ -86,8 +86,7 @@ ValveIo::ValveIo(SimulatedIo& sim) : io(sim) {
           &io.AddOutput(NumberSpec(name + ".dither_Hz", "Hz", 0, 0, 0, "dither frequency"));
     }
   }
-  for (const IoAlias& alias : ValveSignalAliases())
-    io.AddAlias(alias);
+  io.SetAliasTable(&ValveSignalAliases);
 }
 
 std::vector<IoAlias> ValveSignalAliases() {
