@@ -45,7 +45,7 @@ struct NodeStatusSnapshot {
 /// move with every PDO and go out with the periodic publication.
 bool StatusChanged(const NodeStatusSnapshot& a, const NodeStatusSnapshot& b);
 
-/// A simulated input or output: name (e.g. "AIN1.voltage_V") and unit (e.g. "V"). A bool or an
+/// A simulated input or output: name (e.g. "IN1.voltage_mV") and unit (e.g. "mV"). A bool or an
 /// enum has its words by value: {"false", "true"}, or the enum's choices in order; its value is
 /// the index of the word, and IoValue.text carries the word (copied by the publisher, no
 /// allocation).

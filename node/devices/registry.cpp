@@ -15,6 +15,7 @@
 #include "node/devices/quad_controller/quad_controller.hpp"
 #include "node/devices/valve_12in12out/valve_controller.hpp"
 #include "node/devices/valve_12in12out/valve_io.hpp"
+#include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::devices {
 namespace {
@@ -112,6 +113,16 @@ std::string KnownDeviceNames() {
   return known;
 }
 
+std::string UnknownDevice(std::string_view name) {
+  std::vector<std::string> names;
+  for (const DeviceInfo& d : Devices())
+    names.emplace_back(d.name);
+  std::string out = "unknown device \"" + std::string(name) + "\" (";
+  if (const auto nearest = NearestNames(name, names); !nearest.empty())
+    out += "nearest: " + JoinNames(nearest) + "; ";
+  return out + "known: " + KnownDeviceNames() + ")";
+}
+
 std::unique_ptr<SimulatedIo> SignalsOf(const DeviceInfo& info) {
   auto io = std::make_unique<SimulatedIo>();
   info.declare_signals(*io);
@@ -138,8 +149,7 @@ std::unique_ptr<Device> MakeDevice(const DeviceSelection& selection) {
   }
   const DeviceInfo* info = FindDevice(selection.device);
   if (!info) {
-    throw std::invalid_argument("unknown device \"" + selection.device + "\" (known: " + KnownDeviceNames() +
-                                ")");
+    throw std::invalid_argument(UnknownDevice(selection.device));
   }
   return info->create(DeviceOptions{.eds = selection.eds, .ports = info->ports});
 }

@@ -45,6 +45,8 @@ const DeviceInfo* FindDevice(std::string_view name);
 std::string ListDevices();
 /// The known names, comma separated, for messages.
 std::string KnownDeviceNames();
+/// "unknown device \"quad\" (nearest: quad-controller; known: ...)".
+std::string UnknownDevice(std::string_view name);
 
 /// A variant's simulated signals without creating the device (topology checks).
 std::unique_ptr<SimulatedIo> SignalsOf(const DeviceInfo& info);

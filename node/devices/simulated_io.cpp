@@ -6,9 +6,32 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "vocabulary/nearest_names.hpp"
+
 namespace canfleet::devices {
 
 namespace {
+
+// The unit rule (node/devices/README.md "Signals"): one unit per quantity, the one the family's
+// objects count in, so that an object read by SDO and its signal agree.
+constexpr SignalUnit kSignalUnits[] = {
+    {"mV", "mV"},
+    {"mA", "mA"},
+    {"ohm", "ohm"},
+    {"Hz", "Hz"},
+    {"pct", "pct"},
+    {"C", "C"},
+    {"rpm", "rpm"},
+    {"counts", "counts"},
+    {"counts/s", "counts_s"},
+    {"pulses/rev", "pulses_per_rev"},
+};
+
+bool EndsWithUnit(std::string_view name, std::string_view suffix) {
+  if (name.size() <= suffix.size() || !name.ends_with(suffix)) return false;
+  const char before = name[name.size() - suffix.size() - 1];
+  return before == '_' || before == '.';
+}
 
 std::string FormatNumber(double value) {
   // Whole numbers print without a fraction ("2500"), others with up to 6 significant digits.
@@ -62,6 +85,10 @@ bool Matches(IoKind kind, const IoValue& value) {
 }
 
 }  // namespace
+
+std::span<const SignalUnit> SignalUnits() {
+  return kSignalUnits;
+}
 
 IoSpec NumberSpec(std::string name, std::string unit, double min, double max, double initial,
                   std::string description) {
@@ -144,6 +171,16 @@ IoSignal& SimulatedIo::Add(IoSpec spec, IoDirection direction) {
   if (spec.name.empty() || spec.name.find('.') == std::string::npos)
     throw std::logic_error("simulated I/O: signal name \"" + spec.name + "\" is not <channel>.<quantity>");
   if (by_name_.contains(spec.name)) throw std::logic_error("simulated I/O: duplicate signal " + spec.name);
+  if (spec.name.size() > kMaxSignalNameLength)
+    throw std::logic_error("simulated I/O: " + spec.name + " is longer than telemetry's " +
+                           std::to_string(kMaxSignalNameLength) + " characters");
+  if (spec.kind == IoKind::kNumber) {
+    const auto* unit = std::find_if(std::begin(kSignalUnits), std::end(kSignalUnits),
+                                    [&](const SignalUnit& u) { return u.unit == spec.unit; });
+    if (unit == std::end(kSignalUnits) || !EndsWithUnit(spec.name, unit->suffix))
+      throw std::logic_error("simulated I/O: " + spec.name + " [" + spec.unit +
+                             "]: a number's unit is one of the unit rule's and ends its name");
+  }
   if (!Matches(spec.kind, spec.initial))
     throw std::logic_error("simulated I/O: initial value of " + spec.name);
   if (spec.kind == IoKind::kEnum && std::find(spec.choices.begin(), spec.choices.end(),
@@ -184,10 +221,112 @@ void SimulatedIo::Store(IoSignal& signal, IoValue value) {
   }
 }
 
+void SimulatedIo::LoadAliases() const {
+  if (alias_table_ == nullptr) return;
+  auto* table = alias_table_;
+  alias_table_ = nullptr;
+  for (IoAlias& alias : table())
+    const_cast<SimulatedIo*>(this)->AddAlias(std::move(alias));
+}
+
+const std::vector<std::unique_ptr<IoAlias>>& SimulatedIo::Aliases() const {
+  LoadAliases();
+  return aliases_;
+}
+
+void SimulatedIo::AddAlias(IoAlias alias) {
+  LoadAliases();
+  const IoSignal* target = Find(alias.new_name);
+  if (target == nullptr)
+    throw std::logic_error("simulated I/O: alias of an unknown signal " + alias.new_name);
+  if (by_name_.contains(alias.old_name) || alias_by_name_.contains(alias.old_name))
+    throw std::logic_error("simulated I/O: alias " + alias.old_name + " is already a name");
+  if (alias.factor != 1.0 && (target->kind() != IoKind::kNumber || !(alias.factor > 0)))
+    throw std::logic_error("simulated I/O: alias " + alias.old_name + " converts a number only");
+  aliases_.push_back(std::make_unique<IoAlias>(std::move(alias)));
+  alias_by_name_.emplace(aliases_.back()->old_name, aliases_.back().get());
+}
+
+IoStatus SimulatedIo::Unknown(std::string_view name) const {
+  IoStatus status;
+  std::vector<std::string> names;
+  names.reserve(signals_.size());
+  for (const auto& s : signals_)
+    names.push_back(s->name());
+  status.nearest = NearestNames(name, names);
+  status.unknown = true;
+  status.error = "no signal " + std::string(name);
+  if (!status.nearest.empty()) status.error += "; nearest: " + JoinNames(status.nearest);
+  return status;
+}
+
+IoName SimulatedIo::Resolve(std::string_view name) const {
+  IoName out;
+  if (const IoSignal* signal = Find(name)) {
+    out.signal = signal;
+    return out;
+  }
+  LoadAliases();
+  if (auto it = alias_by_name_.find(name); it != alias_by_name_.end()) {
+    out.alias = it->second;
+    out.signal = Find(out.alias->new_name);
+    out.notice = std::string(name) + " is deprecated: use " + out.alias->new_name;
+    if (out.alias->factor != 1.0) {
+      // "(1 V = 1000 mV)", "(1000 uA = 1 mA)"
+      const double f = out.alias->factor;
+      out.notice += " (" +
+                    (f < 1 ? "1 " + out.Unit() + " = " + FormatNumber(1 / f)
+                           : FormatNumber(f) + " " + out.Unit() + " = 1") +
+                    " " + out.signal->spec().unit + ")";
+    }
+    return out;
+  }
+  out.error = Unknown(name);
+  return out;
+}
+
+std::string IoName::Unit() const {
+  if (signal == nullptr) return {};
+  if (alias == nullptr || alias->factor == 1.0) return signal->spec().unit;
+  return alias->old_name.substr(alias->old_name.rfind('_') + 1);  // "current_uA" -> "uA"
+}
+
+std::string IoName::ValueText() const {
+  if (signal == nullptr) return {};
+  if (signal->kind() != IoKind::kNumber) return signal->ToString();
+  const double factor = alias == nullptr ? 1.0 : alias->factor;
+  return FormatNumber(signal->Number() * factor);
+}
+
+std::string IgnoredNotice(const IoSignal& set, std::string_view configuration, std::string_view hint) {
+  std::string out = set.name() + " is set, but " + std::string(configuration) + " does not read it";
+  if (!hint.empty()) out += " (" + std::string(hint) + ")";
+  return out;
+}
+
+void SimulatedIo::NoticeIgnored(const IoSignal& signal, IoStatus& status) const {
+  if (!ignored_hook_) return;
+  const std::string why = ignored_hook_(signal);
+  if (why.empty()) return;
+  if (!status.notice.empty()) status.notice += "; ";
+  status.notice += why;
+}
+
 IoStatus SimulatedIo::Set(std::string_view name, const IoValue& value) {
-  auto it = by_name_.find(name);
-  if (it == by_name_.end()) return {"unknown signal \"" + std::string(name) + "\""};
-  IoSignal& signal = *it->second;
+  if (by_name_.find(name) == by_name_.end()) {
+    IoName resolved = Resolve(name);
+    if (resolved.signal == nullptr) return resolved.error;
+    IoValue converted = value;
+    if (auto* number = std::get_if<double>(&converted)) *number /= resolved.alias->factor;
+    IoStatus status = Set(resolved.signal->name(), converted);
+    if (!status.ok()) {
+      status.error = std::string(name) + " (now " + resolved.signal->name() + "): " + status.error;
+      return status;
+    }
+    status.notice = resolved.notice + (status.notice.empty() ? "" : "; " + status.notice);
+    return status;
+  }
+  IoSignal& signal = *by_name_.find(name)->second;
   const IoSpec& spec = signal.spec();
   if (signal.direction() != IoDirection::kInput)
     return {spec.name + " is an output: the device sets it, a test only reads it"};
@@ -209,12 +348,15 @@ IoStatus SimulatedIo::Set(std::string_view name, const IoValue& value) {
       return {spec.name + ": \"" + choice + "\" is not one of " + JoinChoices(spec.choices)};
   }
   Store(signal, value);
-  return {};
+  IoStatus status;
+  NoticeIgnored(signal, status);
+  return status;
 }
 
 IoStatus SimulatedIo::SetText(std::string_view name, std::string_view text) {
-  const IoSignal* signal = Find(name);
-  if (!signal) return {"unknown signal \"" + std::string(name) + "\""};
+  const IoName resolved = Resolve(name);
+  const IoSignal* signal = resolved.signal;
+  if (!signal) return resolved.error;
   switch (signal->kind()) {
     case IoKind::kNumber: {
       double v = 0;
@@ -242,7 +384,7 @@ const IoSignal* SimulatedIo::Find(std::string_view name) const {
 
 const IoSignal& SimulatedIo::Get(std::string_view name) const {
   const IoSignal* signal = Find(name);
-  if (!signal) throw std::out_of_range("unknown signal \"" + std::string(name) + "\"");
+  if (!signal) throw std::out_of_range(Unknown(name).error);
   return *signal;
 }
 

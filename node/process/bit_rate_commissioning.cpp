@@ -50,7 +50,7 @@ void CommissionBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
     stack.AdoptBitTiming(*c.adopted);
     client->SetBitRate(session->bitrate);  // stated from now on, also to a broker met later
   }
-  if (!c.message.empty() && log) log("port " + std::to_string(p + 1) + ": " + c.message);
+  if (!c.message.empty() && log) log("CAN" + std::to_string(p + 1) + ": " + c.message);
 }
 
 void KeepFactoryBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
@@ -62,7 +62,7 @@ void KeepFactoryBitRate(devices::DeviceNode& node, std::size_t p, BusPort& port,
   client->SetBitRate(*kbit * 1000);
   const auto session = client->Session();
   if (log && session && session->bitrate != *kbit * 1000)
-    log("port " + std::to_string(p + 1) + ": factory bit rate " + std::to_string(*kbit) +
+    log("CAN" + std::to_string(p + 1) + ": factory bit rate " + std::to_string(*kbit) +
         " kbit/s kept on a bus at " + std::to_string(session->bitrate / 1000) +
         " kbit/s: no traffic until a master sets the rate");
 }

@@ -118,11 +118,11 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
                                                        std::size_t p, std::uint32_t kbit,
                                                        bool applied) mutable {
     if (applied) {
-      log->info("port {}: bit rate now {} kbit/s", p + 1, kbit);
+      log->info("CAN{}: bit rate now {} kbit/s", p + 1, kbit);
     } else if (!told[p]) {
       told[p] = true;  // once: the interface's rate does not change with the node's settings
       log->warn(
-          "port {}: bit rate {} kbit/s not applied: a SocketCAN interface runs at the rate it was "
+          "CAN{}: bit rate {} kbit/s not applied: a SocketCAN interface runs at the rate it was "
           "given (ip link set IFACE type can bitrate ...)",
           p + 1, kbit);
     }
@@ -166,7 +166,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   // Hello states it. SocketCAN runs at its interface's rate, whatever the node's settings say.
   for (std::size_t p = 0; p < port_count; ++p) {
     if (options.buses[p].socketcan) {
-      log->info("port {}: bit rate: the SocketCAN interface's ({} is not applied to it)", p + 1,
+      log->info("CAN{}: bit rate: the SocketCAN interface's ({} is not applied to it)", p + 1,
                 "LSS activate bit timing or a bit-rate object");
     } else if (node->stack(p).BitTimingStored()) {
       if (auto kbit = canopen::BitRateKbit(node->stack(p).BitTimingIndex()))
@@ -178,8 +178,11 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
   for (std::size_t p = 0; p < port_count; ++p) {
     auto* client = dynamic_cast<BrokerClientPort*>(ports[p].get());
     if (client == nullptr) continue;
-    client->OnNodeRequest(
-        [&node](const wire::NodeRequest& r) { return node::AnswerNodeRequest(node->io(), r); });
+    client->OnNodeRequest([&node, &log](const wire::NodeRequest& r) {
+      wire::NodeReply reply = node::AnswerNodeRequest(node->io(), r);
+      if (!reply.notice().empty()) log->warn("simulated I/O: {}", reply.notice());
+      return reply;
+    });
     // The broker wakes the node only for frames its stack listens to (an acceptance filter).
     client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
   }
@@ -188,6 +191,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     if (eq == std::string::npos) throw std::invalid_argument("--io " + assignment + ": expected NAME=VALUE");
     auto status = node->io().SetText(assignment.substr(0, eq), assignment.substr(eq + 1));
     if (!status.ok()) throw std::invalid_argument("--io " + assignment + ": " + status.error);
+    if (!status.notice.empty()) log->warn("--io {}: {}", assignment, status.notice);
   }
 
   std::unique_ptr<node::StdinControl> control;

@@ -4,6 +4,26 @@
 
 namespace canfleet::node {
 
+namespace {
+
+wire::IoValue ToWire(const devices::IoName& name, std::string_view as_named) {
+  wire::IoValue out;
+  out.set_name(std::string(as_named));
+  out.set_value(name.ValueText());
+  out.set_unit(name.Unit());
+  out.set_input(name.signal->direction() == devices::IoDirection::kInput);
+  return out;
+}
+
+void Refuse(wire::NodeReply& reply, const devices::IoStatus& status) {
+  reply.set_error(status.error);
+  reply.set_unknown_signal(status.unknown);
+  for (const auto& n : status.nearest)
+    reply.add_nearest(n);
+}
+
+}  // namespace
+
 wire::IoValue ToWire(const devices::IoSignal& signal) {
   wire::IoValue out;
   out.set_name(signal.name());
@@ -25,10 +45,11 @@ wire::NodeReply AnswerNodeRequest(devices::SimulatedIo& io, const wire::NodeRequ
       const wire::IoSet& set = request.io_set();
       const devices::IoStatus status = io.SetText(set.name(), set.value());
       if (!status.ok()) {
-        reply.set_error(status.error);
+        Refuse(reply, status);
         break;
       }
-      *reply.add_values() = ToWire(*io.Find(set.name()));
+      reply.set_notice(status.notice);
+      *reply.add_values() = ToWire(io.Resolve(set.name()), set.name());
       break;
     }
     case wire::NodeRequest::kIoGet: {
@@ -38,12 +59,13 @@ wire::NodeReply AnswerNodeRequest(devices::SimulatedIo& io, const wire::NodeRequ
           *reply.add_values() = ToWire(*signal);
         break;
       }
-      const devices::IoSignal* signal = io.Find(name);
-      if (signal == nullptr) {
-        reply.set_error("unknown signal \"" + name + "\"");
+      const devices::IoName resolved = io.Resolve(name);
+      if (resolved.signal == nullptr) {
+        Refuse(reply, resolved.error);
         break;
       }
-      *reply.add_values() = ToWire(*signal);
+      reply.set_notice(resolved.notice);
+      *reply.add_values() = ToWire(resolved, name);
       break;
     }
     case wire::NodeRequest::REQUEST_NOT_SET:

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <spdlog/spdlog.h>
 #include <asio/read_until.hpp>
 #include <iostream>
 #include <istream>
@@ -36,11 +37,16 @@ std::string StdinControl::Execute(devices::DeviceNode& node, const std::string& 
   if (command == "set") {
     if (name.empty() || value.empty()) return "error: usage: set NAME VALUE";
     auto status = io.SetText(name, value);
-    return status.ok() ? "ok" : "error: " + status.error;
+    if (!status.ok()) return "error: " + status.error;
+    if (!status.notice.empty()) spdlog::warn("simulated I/O: {}", status.notice);
+    return "ok";
   }
   if (command == "get") {
-    const auto* signal = io.Find(name);
-    return signal ? name + " " + signal->ToString() : "error: no signal " + name;
+    const devices::IoName resolved = io.Resolve(name);
+    if (resolved.signal == nullptr) return "error: " + resolved.error.error;
+    if (!resolved.notice.empty()) spdlog::warn("simulated I/O: {}", resolved.notice);
+    const std::string unit = resolved.Unit();
+    return name + " " + resolved.ValueText() + (unit.empty() ? "" : " " + unit);
   }
   if (command == "list") {
     std::string out;

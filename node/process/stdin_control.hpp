@@ -1,8 +1,8 @@
 #pragma once
 /// @file A node-local control interface on standard input, one command per line, for tests and
 /// scripts until the orchestrator's control API drives the node:
-///   set AIN1.voltage_mV 3000   → "ok" or "error: <reason>"
-///   get POUT1.current_mA       → "POUT1.current_mA 1234"
+///   set IN1.voltage_mV 3000   → "ok" or "error: <reason>"
+///   get OUT1.current_mA       → "OUT1.current_mA 1234"
 ///   list                       → every signal, one per line, then "end"
 ///   nmt                        → the NMT state of each port
 /// Replies go to standard output, one line each (flushed), so a test can read them back.

@@ -52,8 +52,9 @@ double FaultManager::Seconds(TimePoint t) const {
 }
 
 const FleetNode& FaultManager::Node(const std::string& name) const {
-  if (name.empty()) throw FaultError("this fault needs --node");
+  if (name.empty()) throw FaultError("this fault needs --node", true);
   if (const FleetNode* node = ctx_.find_node(name)) return *node;
+  // Not a node of the topology: a participant attached under that name (a python-can bus).
   FleetNode participant;
   participant.spec.set_name(name);
   participant.device_label = "participant";
@@ -63,7 +64,8 @@ const FleetNode& FaultManager::Node(const std::string& name) const {
     participant.node_ids.push_back(0);
   }
   if (participant.buses.empty())
-    throw FaultError("no node called '" + name + "' in this fleet (nor a participant of that name attached)");
+    throw FaultError(
+        ctx_.unknown_node ? ctx_.unknown_node(name) : "no node called '" + name + "' in this fleet", true);
   return participants_[name] = std::move(participant);
 }
 
@@ -81,22 +83,22 @@ std::string FaultManager::BusFor(const control::FaultSpec& spec) const {
   if (!spec.bus().empty()) {
     const auto buses = ctx_.broker.Buses();
     if (std::find(buses.begin(), buses.end(), spec.bus()) == buses.end())
-      throw FaultError("no bus called '" + spec.bus() + "'");
+      throw FaultError("no bus called '" + spec.bus() + "'", true);
     if (!spec.node().empty() && Node(spec.node()).PortOn(spec.bus()) < 0)
-      throw FaultError("node '" + spec.node() + "' is not on bus " + spec.bus());
+      throw FaultError("node '" + spec.node() + "' is not on bus " + spec.bus(), true);
     return spec.bus();
   }
   if (!spec.node().empty()) return Node(spec.node()).buses.front();
   const auto buses = ctx_.broker.Buses();
   if (buses.size() == 1) return buses.front();
-  throw FaultError("say which bus (--bus)");
+  throw FaultError("say which bus (--bus)", true);
 }
 
 std::vector<broker::PortId> FaultManager::ReceiverPorts(const std::string& bus,
                                                         const control::FaultSpec& spec) const {
   std::vector<broker::PortId> ports;
   for (const auto& name : spec.receivers()) {
-    if (Node(name).PortOn(bus) < 0) throw FaultError("receiver '" + name + "' is not on bus " + bus);
+    if (Node(name).PortOn(bus) < 0) throw FaultError("receiver '" + name + "' is not on bus " + bus, true);
     ports.push_back(PortOf(bus, name));
   }
   return ports;
@@ -119,7 +121,7 @@ control::FaultInjected FaultManager::Inject(const control::FaultSpec& spec) {
       (!spec.node().empty() || ctx_.broker.Buses().size() == 1))
     fault->spec.set_bus(BusFor(spec));
   if (const auto problem = control::CheckFaultSpec(fault->spec, control::FaultSpelling::kCli))
-    throw FaultError(problem->reason);
+    throw FaultError(problem->reason, true);
   Apply(*fault);  // throws before anything is registered
   if (fault->spec.bus().empty() && !fault->bus.empty()) fault->spec.set_bus(fault->bus);
   fault->summary = control::SummarizeFault(fault->spec);
@@ -176,7 +178,7 @@ void FaultManager::Apply(Fault& fault) {
       ApplyProcessFault(fault);
       break;
     default:
-      throw FaultError("say which fault (kind)");
+      throw FaultError("say which fault (kind)", true);
   }
 }
 
@@ -275,7 +277,7 @@ void FaultManager::ApplyPartition(Fault& fault) {
     auto& ports = groups.emplace_back();
     for (const auto& name : group.nodes()) {
       if (Node(name).PortOn(fault.bus) < 0)
-        throw FaultError("node '" + name + "' is not on bus " + fault.bus);
+        throw FaultError("node '" + name + "' is not on bus " + fault.bus, true);
       ports.push_back(PortOf(fault.bus, name));
     }
   }
@@ -301,7 +303,7 @@ void FaultManager::ApplyBabblingIdiot(Fault& fault) {
   const std::uint32_t id = spec.has_cob_id() ? spec.cob_id() : 0x001;
   CanFrame frame = CanFrame::Data(id, {0xBA, 0xBB, 0x1E, 0xBA, 0xBB, 0x1E, 0xBA, 0xBB});
   if (spec.extended()) frame.flags |= CanFrame::kExtended;
-  if (!frame.valid()) throw FaultError("babbling-idiot: identifier out of range");
+  if (!frame.valid()) throw FaultError("babbling-idiot: identifier out of range", true);
   // The node's own controller floods the bus: the frame is offered in every arbitration ahead of
   // the node's queue, at the bus's full rate, as by a babbling controller.
   try {

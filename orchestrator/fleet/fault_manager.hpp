@@ -24,7 +24,14 @@ namespace canfleet::fleet {
 /// A fault that cannot be injected or cleared as asked; what() is one line for the user.
 class FaultError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  /// @param bad_request the request is wrong in itself (an unknown node or bus, a field its kind
+  ///        does not take), rather than refused by the fleet's state (Response.bad_request)
+  explicit FaultError(const std::string& what, bool bad_request = false)
+      : std::runtime_error(what), bad_request_(bad_request) {}
+  bool bad_request() const { return bad_request_; }
+
+ private:
+  bool bad_request_;
 };
 
 class FaultManager {
@@ -34,6 +41,8 @@ class FaultManager {
     Scheduler& scheduler;
     Supervisor& supervisor;
     std::function<const FleetNode*(const std::string&)> find_node;
+    /// The message for a node find_node does not know (the nearest names); empty: a plain one.
+    std::function<std::string(const std::string&)> unknown_node;
     TimePoint origin{};  ///< uptime 0
     /// A fault began (`started`) or ended; for the log and telemetry.
     std::function<void(const control::FaultStatus&, bool started)> on_event;

@@ -6,6 +6,7 @@
 
 #include "orchestrator/capture/capture_tap.hpp"
 #include "orchestrator/topology/configuration_plan.hpp"
+#include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::fleet {
 
@@ -108,6 +109,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
       .scheduler = scheduler_,
       .supervisor = supervisor_,
       .find_node = [this](const std::string& name) { return FindNode(name); },
+      .unknown_node = [this](const std::string& name) { return UnknownNode(name); },
       .origin = origin_,
       .on_event =
           [this](const control::FaultStatus& status, bool started) {
@@ -175,8 +177,18 @@ const FleetNode* Fleet::FindNode(const std::string& name) const {
 const FleetNode& Fleet::NodeOrThrow(const std::string& name) const {
   if (name.empty()) throw std::invalid_argument("say which node");
   const FleetNode* node = FindNode(name);
-  if (!node) throw std::invalid_argument("no node called '" + name + "' in this fleet");
+  if (!node) throw std::invalid_argument(UnknownNode(name));
   return *node;
+}
+
+std::string Fleet::UnknownNode(const std::string& name) const {
+  std::vector<std::string> names;
+  for (const auto& n : nodes_)
+    names.push_back(n.name());
+  std::string out = "no node called '" + name + "' in this fleet";
+  if (const auto nearest = NearestNames(name, names); !nearest.empty())
+    out += "; nearest: " + JoinNames(nearest);
+  return out + "; all: canfleet status";
 }
 
 std::optional<std::uint8_t> Fleet::NodeIdOn(const std::string& name, const std::string& bus) const {

@@ -149,6 +149,8 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
 
   const FleetNode* FindNode(const std::string& name) const;
   const FleetNode& NodeOrThrow(const std::string& name) const;
+  /// "no node called 'quad-9' in this fleet; nearest: quad-5, quad-6; all: canfleet status".
+  std::string UnknownNode(const std::string& name) const;
   std::optional<std::uint8_t> NodeIdOn(const std::string& name, const std::string& bus) const;
   const FleetNode* NodeAt(const std::string& bus, std::uint8_t node_id) const;
 
@@ -162,8 +164,16 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   // Requests that answer later (SDO, remote I/O) get the responder; the others return a Response.
   void SdoRead(const control::Request& request, std::shared_ptr<control::Responder> responder);
   void SdoWrite(const control::SdoWrite& write, std::function<void(std::string error)> done);
+  /// A node's answer to a simulated-I/O request: an error (bad_request: the node refused the name,
+  /// type or range), or its values and notice.
+  struct IoAnswer {
+    std::string error;
+    bool bad_request = false;
+    std::string notice;
+    control::IoValues values;
+  };
   void IoRequest(const std::string& node, wire::NodeRequest request,
-                 std::function<void(std::string error, control::IoValues values)> done);
+                 std::function<void(const IoAnswer&)> done);
   void StartDump(const control::Request& request, std::shared_ptr<control::Responder> responder);
   void RunStep(const topology::Step& step);
 

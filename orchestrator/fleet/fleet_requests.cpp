@@ -6,6 +6,7 @@
 
 #include "orchestrator/control/sdo_value.hpp"
 #include "orchestrator/fleet/fleet.hpp"
+#include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::fleet {
 
@@ -17,9 +18,11 @@ control::Response Reply(const control::Request& request) {
   return response;
 }
 
-control::Response Failed(const control::Request& request, const std::string& error) {
+control::Response Failed(const control::Request& request, const std::string& error,
+                         bool bad_request = false) {
   control::Response response = Reply(request);
   response.set_error(error);
+  response.set_bad_request(bad_request);
   return response;
 }
 
@@ -69,25 +72,27 @@ void Fleet::Handle(const control::Request& request, std::shared_ptr<control::Res
         wire::NodeRequest node_request;
         node_request.mutable_io_set()->set_name(request.io_set().name());
         node_request.mutable_io_set()->set_value(request.io_set().value());
-        IoRequest(request.io_set().node(), node_request,
-                  [request, responder](const std::string& error, const control::IoValues&) {
-                    responder->Send(error.empty() ? DoneReply(request, request.io_set().name() + " = " +
-                                                                           request.io_set().value())
-                                                  : Failed(request, error));
-                  });
+        IoRequest(request.io_set().node(), node_request, [request, responder](const IoAnswer& answer) {
+          if (!answer.error.empty())
+            return responder->Send(Failed(request, answer.error, answer.bad_request));
+          auto response = DoneReply(request, request.io_set().name() + " = " + request.io_set().value());
+          response.set_notice(answer.notice);
+          responder->Send(response);
+        });
         return;
       }
       case R::kIoGet: {
         NodeOrThrow(request.io_get().node());
         wire::NodeRequest node_request;
         node_request.mutable_io_get()->set_name(request.io_get().name());
-        IoRequest(request.io_get().node(), node_request,
-                  [request, responder](const std::string& error, const control::IoValues& values) {
-                    if (!error.empty()) return responder->Send(Failed(request, error));
-                    auto response = Reply(request);
-                    *response.mutable_io() = values;
-                    responder->Send(response);
-                  });
+        IoRequest(request.io_get().node(), node_request, [request, responder](const IoAnswer& answer) {
+          if (!answer.error.empty())
+            return responder->Send(Failed(request, answer.error, answer.bad_request));
+          auto response = Reply(request);
+          *response.mutable_io() = answer.values;
+          response.set_notice(answer.notice);
+          responder->Send(response);
+        });
         return;
       }
       case R::kSdoRead:
@@ -126,6 +131,10 @@ void Fleet::Handle(const control::Request& request, std::shared_ptr<control::Res
         responder->Send(Failed(request, "empty or unknown request"));
         return;
     }
+  } catch (const FaultError& e) {
+    responder->Send(Failed(request, e.what(), e.bad_request()));
+  } catch (const std::invalid_argument& e) {  // an unknown node, bus or capture; a value out of range
+    responder->Send(Failed(request, e.what(), true));
   } catch (const std::exception& e) {
     responder->Send(Failed(request, e.what()));
   }
@@ -184,6 +193,7 @@ control::Status Fleet::Status() const {
     for (std::size_t p = 0; p < node.buses.size(); ++p) {
       const std::string& bus = node.buses[p];
       auto* port = out->add_ports();
+      port->set_can("CAN" + std::to_string(out->ports_size()));
       port->set_bus(bus);
       port->set_node_id(node.node_ids[p]);
       if (auto it = ports.find({bus, node.name()}); it != ports.end()) {
@@ -235,7 +245,8 @@ void Fleet::SdoRead(const control::Request& request, std::shared_ptr<control::Re
   const auto& read = request.sdo_read();
   const FleetNode& node = NodeOrThrow(read.node());
   if (read.port() >= node.buses.size())
-    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(read.port()));
+    throw std::invalid_argument("node '" + node.name() + "' has no CAN" + std::to_string(read.port() + 1) +
+                                " (it has " + std::to_string(node.buses.size()) + " CAN port(s))");
   if (read.index() > 0xFFFF || read.subindex() > 0xFF)
     throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
   if (!read.type().empty()) control::RequireSdoType(read.type());  // refuse an unknown type before the bus
@@ -262,7 +273,8 @@ void Fleet::SdoRead(const control::Request& request, std::shared_ptr<control::Re
 void Fleet::SdoWrite(const control::SdoWrite& write, std::function<void(std::string error)> done) {
   const FleetNode& node = NodeOrThrow(write.node());
   if (write.port() >= node.buses.size())
-    throw std::invalid_argument("node '" + node.name() + "' has no port " + std::to_string(write.port()));
+    throw std::invalid_argument("node '" + node.name() + "' has no CAN" + std::to_string(write.port() + 1) +
+                                " (it has " + std::to_string(node.buses.size()) + " CAN port(s))");
   if (write.index() > 0xFFFF || write.subindex() > 0xFF)
     throw std::invalid_argument("index 0..FFFFh, sub-index 0..FFh");
   auto data = control::EncodeSdoValue(write.type(), write.value());
@@ -275,24 +287,40 @@ void Fleet::SdoWrite(const control::SdoWrite& write, std::function<void(std::str
 }
 
 void Fleet::IoRequest(const std::string& node_name, wire::NodeRequest request,
-                      std::function<void(std::string error, control::IoValues values)> done) {
+                      std::function<void(const IoAnswer&)> done) {
   const FleetNode& node = NodeOrThrow(node_name);
-  server_.RequestNode(node.buses.front(), node.name(), std::move(request),
-                      [done, node_name](std::optional<wire::NodeReply> reply) {
-                        control::IoValues values;
-                        values.set_node(node_name);
-                        if (!reply)
-                          return done("node '" + node_name + "' did not answer (is it attached?)", values);
-                        if (!reply->error().empty()) return done(reply->error(), values);
-                        for (const auto& v : reply->values()) {
-                          auto* out = values.add_values();
-                          out->set_name(v.name());
-                          out->set_value(v.value());
-                          out->set_unit(v.unit());
-                          out->set_input(v.input());
-                        }
-                        done({}, values);
-                      });
+  const std::string asked = request.has_io_set() ? request.io_set().name() : request.io_get().name();
+  server_.RequestNode(
+      node.buses.front(), node.name(), std::move(request),
+      [done, node_name, asked](std::optional<wire::NodeReply> reply) {
+        IoAnswer answer;
+        answer.values.set_node(node_name);
+        if (!reply) {
+          answer.error = "node '" + node_name + "' did not answer (is it attached?)";
+          return done(answer);
+        }
+        if (!reply->error().empty()) {
+          // What the node refuses is the request's fault: a name, a type, a range.
+          answer.bad_request = true;
+          answer.error = reply->error();
+          if (reply->unknown_signal()) {
+            answer.error = "no signal " + asked + " on " + node_name;
+            if (reply->nearest_size() > 0)
+              answer.error += "; nearest: " + JoinNames({reply->nearest().begin(), reply->nearest().end()});
+            answer.error += "; all: canfleet io get " + node_name;
+          }
+          return done(answer);
+        }
+        answer.notice = reply->notice();
+        for (const auto& v : reply->values()) {
+          auto* out = answer.values.add_values();
+          out->set_name(v.name());
+          out->set_value(v.value());
+          out->set_unit(v.unit());
+          out->set_input(v.input());
+        }
+        done(answer);
+      });
 }
 
 void Fleet::StartDump(const control::Request& request, std::shared_ptr<control::Responder> responder) {

@@ -110,9 +110,12 @@ void Fleet::RunStep(const topology::Step& step) {
         wire::NodeRequest request;
         request.mutable_io_set()->set_name(step.io().name());
         request.mutable_io_set()->set_value(step.io().value());
-        IoRequest(step.io().node(), request, [t, step](const std::string& error, const control::IoValues&) {
-          if (!error.empty())
-            spdlog::error("scenario t={}s: io {} {}: {}", t, step.io().node(), step.io().name(), error);
+        IoRequest(step.io().node(), request, [t, step](const IoAnswer& answer) {
+          if (!answer.error.empty())
+            spdlog::error("scenario t={}s: io {} {}: {}", t, step.io().node(), step.io().name(),
+                          answer.error);
+          else if (!answer.notice.empty())
+            spdlog::warn("scenario t={}s: io {}: {}", t, step.io().node(), answer.notice);
         });
         break;
       }
@@ -147,9 +150,9 @@ void Fleet::ReadIo(const std::string& node, const std::string& name, IoDone done
   wire::NodeRequest request;
   request.mutable_io_get()->set_name(name);
   try {
-    IoRequest(node, request, [done, name](const std::string& error, const control::IoValues& values) {
-      if (!error.empty()) return done(error, {}, {});
-      for (const auto& v : values.values())
+    IoRequest(node, request, [done, name](const IoAnswer& answer) {
+      if (!answer.error.empty()) return done(answer.error, {}, {});
+      for (const auto& v : answer.values.values())
         if (v.name() == name) return done({}, v.value(), v.unit());
       done("no signal " + name + " in the node's answer", {}, {});
     });

@@ -55,13 +55,13 @@ struct Progress {
   bool started = false;
   bool done = false;  ///< every step ran and every expectation is decided
   /// The latest step that began: an action that ran or an expectation whose window opened. Its
-  /// name, or for an unnamed action what it does ("io quad-5 AIN1.voltage_mV=1800"); "" before.
+  /// name, or for an unnamed action what it does ("io quad-5 IN1.voltage_mV=1800"); "" before.
   std::string step;
   std::optional<TimePoint> step_time;
 };
 
 /// What an action step does, in a few words: "inject heartbeat-loss quad-5", "clear hb-loss",
-/// "io quad-5 AIN1.voltage_mV=1800", "nmt start quad-6", "sdo write quad-5 1017h sub 0".
+/// "io quad-5 IN1.voltage_mV=1800", "nmt start quad-6", "sdo write quad-5 1017h sub 0".
 std::string ActionText(const topology::Step& step);
 
 struct RunnerOptions {

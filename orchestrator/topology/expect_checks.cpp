@@ -1,5 +1,7 @@
 #include "orchestrator/topology/expect_checks.hpp"
 
+#include "orchestrator/topology/node_checks.hpp"
+
 #include <cstdlib>
 #include <set>
 
@@ -98,15 +100,10 @@ void CheckSdoExpect(const Scope& s, const TopologyFacts& facts, const SdoExpect&
 
 void CheckIoExpect(const Scope& s, const TopologyFacts& facts, const IoExpect& e) {
   const NodeFacts& node = RequirePort(s, facts, e.node(), 0);
-  if (e.name().empty()) s.Fail("name", "required: the signal (e.g. POUT1.current_mA)");
+  if (e.name().empty()) s.Fail("name", "required: the signal (e.g. OUT1.current_mA)");
   if (node.io == nullptr || node.io->Signals().empty())
     s.Fail("name", "node " + node.name + " is a " + node.kind + ": it has no simulated I/O");
-  if (node.io->Find(e.name()) == nullptr) {
-    std::string names;
-    for (const auto& sig : node.io->Signals())
-      names += (names.empty() ? "" : ", ") + sig->name();
-    s.Fail("name", node.kind + " has no signal " + Quote(e.name()) + " (its signals: " + names + ")");
-  }
+  ResolveSignal(s, "name", node, e.name(), false);
   const bool range = e.has_min() || e.has_max();
   if (!e.value().empty() && range)
     s.Fail(e.has_min() ? "min" : "max", "give a value or a range (min, max), not both");

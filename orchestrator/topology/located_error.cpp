@@ -73,12 +73,16 @@ Scope Scope::Child(std::string_view field, const pb::Message& child, int index) 
   if (tree_ != nullptr) nested = tree_->GetTreeForNested(fd, fd->is_repeated() ? std::max(index, 0) : -1);
   std::string path = path_.empty() ? std::string(field) : path_ + "." + std::string(field);
   if (fd->is_repeated()) path += "[" + std::to_string(std::max(index, 0)) + "]";
-  return Scope(file_, &child, nested, std::move(path), At(field, index));
+  return Scope(file_, &child, nested, std::move(path), At(field, index), warnings_);
 }
 
 void Scope::Fail(std::string_view field, int index, std::string reason) const {
   const Loc l = At(field, index);
   throw TopologyError(*file_, l.line, l.column, PathOf(field, index), std::move(reason));
+}
+
+void Scope::Note(std::string_view field, std::string reason) const {
+  if (warnings_ != nullptr) warnings_->push_back(Warn(field, std::move(reason)));
 }
 
 void Scope::FailHere(std::string reason) const {

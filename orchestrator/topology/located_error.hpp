@@ -8,6 +8,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "orchestrator/topology/topology_warning.hpp"
 
@@ -45,8 +46,10 @@ class FirstErrorCollector final : public pb::io::ErrorCollector {
 /// error.
 class Scope {
  public:
-  Scope(const std::string* file, const pb::Message* message, const Tree* tree, std::string path, Loc loc)
-      : file_(file), message_(message), tree_(tree), path_(std::move(path)), loc_(loc) {}
+  /// @param warnings where Note appends (null: notes are dropped)
+  Scope(const std::string* file, const pb::Message* message, const Tree* tree, std::string path, Loc loc,
+        std::vector<TopologyWarning>* warnings = nullptr)
+      : file_(file), message_(message), tree_(tree), path_(std::move(path)), loc_(loc), warnings_(warnings) {}
 
   Loc loc() const { return loc_; }
   const std::string& path() const { return path_; }
@@ -67,6 +70,9 @@ class Scope {
   }
   /// An error about the message as a whole (a missing field is named by the caller's reason).
   [[noreturn]] void FailHere(std::string reason) const;
+  /// Accepts the file but says something about it while it is checked: appends Warn(field,
+  /// reason) to the loader's warnings (LoadedTopology::warnings), e.g. an old signal name.
+  void Note(std::string_view field, std::string reason) const;
 
   /// A warning located as Fail() locates an error: the index-th value of `field`.
   TopologyWarning Warn(std::string_view field, int index, std::string reason) const;
@@ -84,6 +90,7 @@ class Scope {
   const Tree* tree_;
   std::string path_;
   Loc loc_;
+  std::vector<TopologyWarning>* warnings_;
 };
 
 }  // namespace canfleet::topology::detail

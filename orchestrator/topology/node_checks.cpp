@@ -1,5 +1,7 @@
 #include "orchestrator/topology/node_checks.hpp"
 
+#include "vocabulary/nearest_names.hpp"
+
 #include <mutex>
 #include <optional>
 #include <set>
@@ -10,6 +12,7 @@
 #include "node/canopen/eds/eds_reader.hpp"
 #include "node/devices/eds_dictionary.hpp"
 #include "orchestrator/control/sdo_value.hpp"
+#include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::topology::detail {
 
@@ -188,9 +191,7 @@ void NodeChecks::CheckDevice(const Scope& s, const Node& node, NodeFacts& facts)
   }
   if (!node.device().empty()) {
     const devices::DeviceInfo* info = devices::FindDevice(node.device());
-    if (info == nullptr)
-      s.Fail("device",
-             "unknown device " + Quote(node.device()) + " (known: " + devices::KnownDeviceNames() + ")");
+    if (info == nullptr) s.Fail("device", devices::UnknownDevice(node.device()));
     facts.ports = info->ports;
     facts.kind = std::string(info->name);
     facts.variant = info;
@@ -318,24 +319,34 @@ void NodeChecks::CheckHeartbeats(const Scope& root) {
 void CheckIoSet(const Scope& s, std::string_view name_field, std::string_view value_field,
                 const NodeFacts& facts, const std::string& name, const std::string& value) {
   if (!LooksLikeSignalName(name))
-    s.Fail(name_field, Quote(name) + " is not a signal name (CHANNEL.quantity, e.g. AIN1.voltage_mV)");
+    s.Fail(name_field, Quote(name) + " is not a signal name (CHANNEL.quantity, e.g. IN1.voltage_mV)");
   if (value.empty()) s.Fail(value_field, "required: the value to set " + name + " to");
   devices::SimulatedIo& io = *facts.io;
-  const devices::IoSignal* signal = io.Find(name);
-  if (signal == nullptr) {
-    if (io.Signals().empty())
-      s.Fail(name_field, "node " + facts.name + " is a " + facts.kind + ": it has no simulated I/O");
-    std::string inputs;
-    for (const auto& sig : io.Signals()) {
-      if (sig->direction() == devices::IoDirection::kInput)
-        inputs += (inputs.empty() ? "" : ", ") + sig->name();
-    }
-    s.Fail(name_field, facts.kind + " has no signal " + Quote(name) + " (its inputs: " + inputs + ")");
-  }
-  if (signal->direction() != devices::IoDirection::kInput)
+  const devices::IoName resolved = ResolveSignal(s, name_field, facts, name, true);
+  if (resolved.signal->direction() != devices::IoDirection::kInput)
     s.Fail(name_field, name + " is an output of " + facts.kind + "; only inputs can be set");
   const devices::IoStatus status = io.SetText(name, value);
   if (!status.ok()) s.Fail(value_field, status.error);
+}
+
+devices::IoName ResolveSignal(const Scope& s, std::string_view name_field, const NodeFacts& facts,
+                              const std::string& name, bool inputs_only) {
+  const devices::SimulatedIo& io = *facts.io;
+  if (io.Signals().empty())
+    s.Fail(name_field, "node " + facts.name + " is a " + facts.kind + ": it has no simulated I/O");
+  devices::IoName resolved = io.Resolve(name);
+  if (resolved.signal == nullptr) {
+    std::string all;
+    for (const auto& sig : io.Signals()) {
+      if (!inputs_only || sig->direction() == devices::IoDirection::kInput)
+        all += (all.empty() ? "" : ", ") + sig->name();
+    }
+    std::string reason = facts.kind + " has no signal " + Quote(name);
+    if (!resolved.error.nearest.empty()) reason += "; nearest: " + JoinNames(resolved.error.nearest);
+    s.Fail(name_field, reason + " (its " + (inputs_only ? "inputs" : "signals") + ": " + all + ")");
+  }
+  if (!resolved.notice.empty()) s.Note(name_field, resolved.notice);
+  return resolved;
 }
 
 void CheckSdo(const Scope& s, const NodeFacts& facts, std::uint32_t index, std::uint32_t subindex,

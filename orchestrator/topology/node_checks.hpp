@@ -40,6 +40,11 @@ class NodeChecks {
   std::map<std::string, std::unique_ptr<devices::SimulatedIo>> signals_;
 };
 
+/// The node's signal called `name` (an old name warns, naming the new one); an unknown name fails
+/// with the nearest names and the list of the node's signals (inputs only when `inputs_only`).
+devices::IoName ResolveSignal(const Scope& s, std::string_view name_field, const NodeFacts& facts,
+                              const std::string& name, bool inputs_only);
+
 /// An input of the node's device set to `value` (node io and scenario io steps).
 void CheckIoSet(const Scope& s, std::string_view name_field, std::string_view value_field,
                 const NodeFacts& facts, const std::string& name, const std::string& value);

@@ -37,7 +37,7 @@ std::string NameProblem(std::string_view name);
 /// Bus names also appear in "--bus can0@tcp://..." and socketcand's "< open can0 >": letters,
 /// digits, '_', '-', '.'. Returns what is wrong, or "".
 std::string BusNameProblem(std::string_view name);
-/// "AIN1.voltage_mV": CHANNEL.quantity, both identifiers.
+/// "IN1.voltage_mV": CHANNEL.quantity, both identifiers.
 bool LooksLikeSignalName(std::string_view name);
 
 /// What validation learned about one node, for cross-checks and for the defaults.

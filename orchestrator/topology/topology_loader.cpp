@@ -50,7 +50,8 @@ class Loader {
 
   LoadedTopology Run(std::string_view text) {
     Parse(text);
-    const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1});
+    std::vector<TopologyWarning> warnings;  // what the checks note on the way (an old signal name)
+    const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1}, &warnings);
     CheckTopology(root);
     CheckOrchestrator(root);
     CheckTime(root);
@@ -64,7 +65,9 @@ class Loader {
     std::vector<int> step_lines;
     for (int i = 0; i < spec_.scenario_size(); ++i)
       step_lines.push_back(root.Child("scenario", spec_.scenario(i), i).loc().line);
-    return LoadedTopology{std::move(spec_), file_, std::move(step_lines), std::move(feasibility.warnings),
+    warnings.insert(warnings.end(), std::make_move_iterator(feasibility.warnings.begin()),
+                    std::make_move_iterator(feasibility.warnings.end()));
+    return LoadedTopology{std::move(spec_), file_, std::move(step_lines), std::move(warnings),
                           std::move(feasibility.loads)};
   }
 

@@ -62,7 +62,9 @@ struct LoadedTopology {
   Topology spec;
   std::filesystem::path file;
   std::vector<int> step_lines;  ///< the line of each scenario step (1-based), for reports
-  /// Configurations that load but cannot work (topology_warnings.hpp), in a stable order.
+  /// What the file may want to change though it loads: old names (e.g. a deprecated signal
+  /// name, noted while checking), then configurations that cannot work (topology_warnings.hpp),
+  /// in a stable order.
   std::vector<TopologyWarning> warnings;
   /// The periodic load each bus is offered (bus_load.hpp), one per bus in file order.
   std::vector<BusLoad> loads;

@@ -6,7 +6,7 @@ it through the orchestrator's control API - status, faults, simulated I/O, SDO, 
         quad6.sdo_write(0x1017, 0, 1000, "u16")
         with fleet.inject("heartbeat-loss", node="quad-5"):
             ...
-        print(quad6.io_get("POUT1.current_mA").value)
+        print(quad6.io_get("OUT1.current_mA").value)
 
 The shape follows python-canopen's Network/RemoteNode: a Fleet holds Nodes by name; every refusal
 of the orchestrator is an OrchestratorError carrying its message.
@@ -181,7 +181,7 @@ class Node:
 
     # -- simulated I/O -----------------------------------------------------------------------
     def io_get(self, name: str) -> IoValue:
-        """One signal ("POUT1.current_mA")."""
+        """One signal ("OUT1.current_mA")."""
         values = self.fleet._call(pb.Request(io_get=pb.IoGet(node=self.name, name=name))).io.values
         v = values[0]
         return IoValue(v.name, v.value, v.unit, v.input)
@@ -192,7 +192,7 @@ class Node:
         return {v.name: IoValue(v.name, v.value, v.unit, v.input) for v in values}
 
     def io_set(self, name: str, value: Union[int, float, bool, str]) -> IoValue:
-        """Sets an input ("AIN1.voltage_mV", 1800); returns it as now set."""
+        """Sets an input ("IN1.voltage_mV", 1800); returns it as now set."""
         text = ("true" if value else "false") if isinstance(value, bool) else str(value)
         self.fleet._call(pb.Request(io_set=pb.IoSet(node=self.name, name=name, value=text)))
         return self.io_get(name)

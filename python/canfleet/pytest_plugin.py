@@ -3,7 +3,7 @@ failing test's report carries.
 
     @pytest.mark.topology("topologies/pair.textproto")
     def test_quad(fleet):                 # a canfleet.Fleet, ready, stopped after the test
-        fleet.node("quad-5").io_set("AIN1.voltage_mV", 1800)
+        fleet.node("quad-5").io_set("IN1.voltage_mV", 1800)
 
 Options: --canfleet-topology FILE (for tests without the marker), --canfleet-time real|virtual,
 --canfleet-seed N, --canfleet-bin DIR (canfleet and canfleet-node), --canfleet-keep (keep every

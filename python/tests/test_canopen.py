@@ -87,7 +87,7 @@ def test_tpdo_callback_gets_the_mapped_input(fleet: Fleet, network: canopen.Netw
             received.append(int(pdo_map[0].raw))
 
     quad5.tpdo[1].add_callback(on_tpdo)
-    fleet.node("quad-5").io_set("AIN1.voltage_mV", 2100)
+    fleet.node("quad-5").io_set("IN1.voltage_mV", 2100)
     # TPDO1 185h maps AIN1 (7100h.1, mV; Quad manual §3.1.1).
     assert wait_until(lambda: 2100 in received), received[-5:]
 

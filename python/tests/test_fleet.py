@@ -44,11 +44,11 @@ def test_sdo_write_read_back_and_abort_code(fleet: Fleet) -> None:
 
 def test_io_set_on_one_node_moves_the_output_of_its_pdo_consumer(fleet: Fleet) -> None:
     # quad-5 TPDO1 (185h, AIN1 in mV) -> quad-6 RPDO1 -> POUT1 in mA (Quad manual §3.1.1, §3.5.1).
-    assert fleet.node("quad-5").io_set("AIN1.voltage_mV", 1800).value == "1800"
-    pout = wait_until(lambda: fleet.node("quad-6").io_get("POUT1.current_mA").value == "1800")
-    assert pout, fleet.node("quad-6").io_get("POUT1.current_mA")
-    assert fleet.node("quad-6").io_get("POUT1.current_mA").unit == "mA"
-    assert "AIN1.voltage_mV" in fleet.node("quad-5").io_all()
+    assert fleet.node("quad-5").io_set("IN1.voltage_mV", 1800).value == "1800"
+    pout = wait_until(lambda: fleet.node("quad-6").io_get("OUT1.current_mA").value == "1800")
+    assert pout, fleet.node("quad-6").io_get("OUT1.current_mA")
+    assert fleet.node("quad-6").io_get("OUT1.current_mA").unit == "mA"
+    assert "IN1.voltage_mV" in fleet.node("quad-5").io_all()
 
 
 def test_nmt_stop_and_start_are_seen_in_the_heartbeat(fleet: Fleet) -> None:
@@ -92,7 +92,7 @@ def test_refusals_carry_the_orchestrators_message(fleet: Fleet) -> None:
     with pytest.raises(canfleet.OrchestratorError, match="cob"):
         fleet.inject("rpdo-timeout", node="quad-6")  # needs --cob-id (orchestrator/control/fault_kinds.cpp)
     with pytest.raises(canfleet.OrchestratorError):
-        fleet.node("nobody").io_get("AIN1.voltage_mV")
+        fleet.node("nobody").io_get("IN1.voltage_mV")
 
 
 def test_bad_fault_arguments_raise_before_anything_is_sent(fleet: Fleet) -> None:

@@ -92,17 +92,17 @@ QUAD = Variant(
     device="quad-controller",
     eds=BUILD / "node/devices/quad_controller/quad-controller.eds",
     node_id=5,
-    default_io=["AIN1.voltage_mV=0", "AIN2.voltage_mV=0", "AIN3.voltage_mV=0", "AIN4.voltage_mV=0",
-                "FIN1.duty_pct=0", "FIN2.duty_pct=0"],
+    default_io=["IN1.voltage_mV=0", "IN2.voltage_mV=0", "IN3.voltage_mV=0", "IN4.voltage_mV=0",
+                "IN5.duty_pct=0", "IN6.duty_pct=0"],
     # Manual §3.1.1 default TPDO1: 7100h sub 1-4, the AI field values, in mV at the default 0-5 V
-    # sensor type (§3.3.1); 6000h sub 1 in TPDO3 has bit n-1 set for a high DINn (§3.2.1).
-    pdo_io=[("AIN1.voltage_mV", "1200"), ("AIN2.voltage_mV", "800"), ("AIN3.voltage_mV", "400"),
-            ("AIN4.voltage_mV", "1600")],
+    # sensor type (§3.3.1); 6000h sub 1 in TPDO3 has bit n-1 set for a high INn.level (§3.2.1).
+    pdo_io=[("IN1.voltage_mV", "1200"), ("IN2.voltage_mV", "800"), ("IN3.voltage_mV", "400"),
+            ("IN4.voltage_mV", "1600")],
     tpdo_expected={(0x7100, 1): 1200, (0x7100, 2): 800, (0x7100, 3): 400, (0x7100, 4): 1600},
     # Manual §3.1.1 default RPDO1: 7330h sub 1-4, the POUT current commands (mA) with 3010h = 0
     # (control by CAN, §3.5.1); the measured current 30C0h follows (§3.5.22).
     rpdo_values={(0x7330, 1): 500, (0x7330, 2): 600, (0x7330, 3): 700, (0x7330, 4): 800},
-    rpdo_outputs={"POUT1.current_mA": "500", "POUT4.current_mA": "800"},
+    rpdo_outputs={"OUT1.current_mA": "500", "OUT4.current_mA": "800"},
     # Manual §4.1/§4.2: a lost heartbeat is 8130h with description 08h and the node-ID as channel;
     # only the generic bit of 1001h is used (§3.1.3, canfleet's README choice 1).
     hb_register=0x01,
@@ -111,11 +111,11 @@ QUAD = Variant(
     device_faults=[
         DeviceFault(
             what="short circuit at POUT1 (manual §4.1: 2320h, description 04h, channel 01h)",
-            inject=_io_set("POUT1.load", "short"), clear=_io_set("POUT1.load", "nominal"),
+            inject=_io_set("OUT1.load", "short"), clear=_io_set("OUT1.load", "nominal"),
             code=0x2320, register=0x01, data=bytes([0x01, 0x04, 0, 0, 0]), history=0x04012320),
         DeviceFault(
             what="open circuit at POUT2 (manual §4.1: 3300h, description 04h, channel 02h)",
-            inject=_io_set("POUT2.load", "open"), clear=_io_set("POUT2.load", "nominal"),
+            inject=_io_set("OUT2.load", "open"), clear=_io_set("OUT2.load", "nominal"),
             code=0x3300, register=0x01, data=bytes([0x02, 0x04, 0, 0, 0]), history=0x04023300),
     ],
 )
@@ -169,8 +169,8 @@ DATALOGGER = Variant(
     measured=lambda index, sub: index == 0x5020,
     # §3.2.15 default TPDO1: 7100h sub 1-4, the AI field values: volts with 2102h = 3 decimal
     # digits (the default for the default voltage sensor type 6110h = 40, Table 11), i.e. mV.
-    pdo_io=[("AIN1.voltage_mV", "1200"), ("AIN2.voltage_mV", "800"), ("AIN3.voltage_mV", "400"),
-            ("AIN4.voltage_mV", "1600")],
+    pdo_io=[("IN1.voltage_mV", "1200"), ("IN2.voltage_mV", "800"), ("IN3.voltage_mV", "400"),
+            ("IN4.voltage_mV", "1600")],
     tpdo_expected={(0x7100, 1): 1200, (0x7100, 2): 800, (0x7100, 3): 400, (0x7100, 4): 1600},
     # §3.2.14 default RPDO1: 2500h sub 1-4, the extra received process values (INTEGER16).
     rpdo_values={(0x2500, 1): 100, (0x2500, 2): -200, (0x2500, 3): 3000, (0x2500, 4): -32768},
@@ -185,7 +185,7 @@ DATALOGGER = Variant(
             code=0xF002, register=0x01, data=bytes([0x10, 0x10, 0, 0, 0]), history=0x1010F002),
         DeviceFault(
             what="supply overvoltage (UMAX181001 §1.8, §3.4.71 5023h = 35 V, Table 26: 20003000h)",
-            inject=_io_set("VPS.voltage_V", "40"), clear=_io_set("VPS.voltage_V", "24"),
+            inject=_io_set("VPS.voltage_mV", "40000"), clear=_io_set("VPS.voltage_mV", "24000"),
             code=0x3000, register=0x01, data=bytes([0x00, 0x20, 0, 0, 0]), history=0x20003000),
     ],
 )
@@ -215,8 +215,8 @@ VALVE = Variant(
     measured=lambda index, sub: index == 0x5020 or (index in (0x7100, 0x7130) and 1 <= sub <= 7),
     # §3.2.15 default TPDO1: 7100h sub 1-4, UI1-4 field values in mV at the default 0-5 V type
     # (6110h = 40, §3.3.2, Table 10).
-    pdo_io=[("UI1.voltage_mV", "1200"), ("UI2.voltage_mV", "800"), ("UI3.voltage_mV", "400"),
-            ("UI4.voltage_mV", "1600")],
+    pdo_io=[("IN1.voltage_mV", "1200"), ("IN2.voltage_mV", "800"), ("IN3.voltage_mV", "400"),
+            ("IN4.voltage_mV", "1600")],
     tpdo_expected={(0x7100, 1): 1200, (0x7100, 2): 800, (0x7100, 3): 400, (0x7100, 4): 1600},
     # §3.2.14 default RPDO1: 7300h sub 1-4, "CANopen message 1-4", which OUT1-4 follow by default
     # (2340h = 1, 2341h = n, §3.4.34/35), 300..1500 onto 300..1500 mA (7320h-7323h, Table 14).
@@ -229,11 +229,11 @@ VALVE = Variant(
     device_faults=[
         DeviceFault(
             what="UI1 below its span start (§1.3, §3.4.8 7148h = 200 mV, 2112h 1 s; Table 33: 4001F001h)",
-            inject=_io_set("UI1.voltage_mV", "100"), clear=_io_set("UI1.voltage_mV", "2500"),
+            inject=_io_set("IN1.voltage_mV", "100"), clear=_io_set("IN1.voltage_mV", "2500"),
             code=0xF001, register=0x01, data=bytes([0x01, 0x40, 0, 0, 0]), history=0x4001F001),
         DeviceFault(
             what="supply overvoltage (§1.10, §3.4.102 5023h = 35 V; Table 33: 20003000h)",
-            inject=_io_set("VPS.voltage_V", "40"), clear=_io_set("VPS.voltage_V", "24"),
+            inject=_io_set("VPS.voltage_mV", "40000"), clear=_io_set("VPS.voltage_mV", "24000"),
             code=0x3000, register=0x01, data=bytes([0x00, 0x20, 0, 0, 0]), history=0x20003000),
     ],
 )
@@ -264,7 +264,7 @@ ENCODER = Variant(
     device_faults=[
         DeviceFault(
             what="supply undervoltage (1.5, 5041h.3 = 9.0 V after 5051h.2 x 100 ms; README: 40003000h)",
-            inject=_io_set("VPS.voltage_V", "8"), clear=_io_set("VPS.voltage_V", "24"),
+            inject=_io_set("VPS.voltage_mV", "8000"), clear=_io_set("VPS.voltage_mV", "24000"),
             code=0x3000, register=0x01, data=bytes([0x00, 0x40, 0, 0, 0]), history=0x40003000),
         DeviceFault(
             what="processor over-temperature (1.5, 5041h.1 = 110.0 C; README: 20004200h)",
@@ -286,7 +286,7 @@ POWER_SUPPLY = Variant(
     measured=lambda index, sub: index == 0x6113 and sub == 1,
     # §2.2.15 default TPDO2: 6204h.1 output voltage (off: 0 mV), 6113h.1 input voltage in mV (the
     # filtered measurement, README choice 9).
-    pdo_io=[("VIN.voltage_V", "20")],
+    pdo_io=[("VIN.voltage_mV", "20000")],
     tpdo_expected={(0x6113, 1): 20000, (0x6204, 1): 0},
     # §2.2.14 default RPDO1: 6200h.2 on/off (FDh = on, §2.3.16), 6200h.3 quit failure (FFh = no
     # action); with 6010h.1 = FFh the latest command wins (§1.2.1 Table 1): the output goes on.
@@ -299,11 +299,11 @@ POWER_SUPPLY = Variant(
     device_faults=[
         DeviceFault(
             what="input undervoltage (§1.2.3, 6114h = 9 V, 6119h.1 + 6013h.1 delays; Table 9: 0000FF04h)",
-            inject=_io_set("VIN.voltage_V", "8"), clear=_io_set("VIN.voltage_V", "24"),
+            inject=_io_set("VIN.voltage_mV", "8000"), clear=_io_set("VIN.voltage_mV", "24000"),
             code=0xFF04, register=0x01, data=bytes(5), history=0x0000FF04),
         DeviceFault(
             what="input overvoltage (§1.2.3, 6115h = 48 V, README choice 13; Table 9: 0000FF04h)",
-            inject=_io_set("VIN.voltage_V", "50"), clear=_io_set("VIN.voltage_V", "24"),
+            inject=_io_set("VIN.voltage_mV", "50000"), clear=_io_set("VIN.voltage_mV", "24000"),
             code=0xFF04, register=0x01, data=bytes(5), history=0x0000FF04),
     ],
 )

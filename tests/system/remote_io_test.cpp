@@ -75,7 +75,7 @@ class RemoteIo : public ::testing::Test {
   std::string endpoint_;
 };
 
-// Given a quad controller process attached as quad-5, when the orchestrator sets AIN1.voltage_mV
+// Given a quad controller process attached as quad-5, when the orchestrator sets IN1.voltage_mV
 // to 3000 over the wire, then reading it back gives 3000 mV (an input); an unknown signal and an
 // out-of-range value are refused with SimulatedIo's one-line reason and change nothing.
 TEST_F(RemoteIo, SetAndReadBackAnInputOfARealNodeProcess) {
@@ -84,30 +84,36 @@ TEST_F(RemoteIo, SetAndReadBackAnInputOfARealNodeProcess) {
                     dir_.File("node.log"));
   ASSERT_TRUE(RunUntil([&] { return Attached("quad-5"); })) << node.Log();
 
-  auto reply = Ask("quad-5", Set(1, "AIN1.voltage_mV", "3000"));
+  auto reply = Ask("quad-5", Set(1, "IN1.voltage_mV", "3000"));
   ASSERT_TRUE(reply) << node.Log();
   EXPECT_EQ(reply->request_id(), 1u);
   EXPECT_EQ(reply->error(), "");
   ASSERT_EQ(reply->values_size(), 1);
   EXPECT_EQ(reply->values(0).value(), "3000");
 
-  reply = Ask("quad-5", Get(2, "AIN1.voltage_mV"));
+  reply = Ask("quad-5", Get(2, "IN1.voltage_mV"));
   ASSERT_TRUE(reply);
   EXPECT_EQ(test::WireText(*reply),
-            R"(request_id: 2 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })");
+            R"(request_id: 2 values { name: "IN1.voltage_mV" value: "3000" unit: "mV" input: true })");
 
-  reply = Ask("quad-5", Set(3, "AIN9.voltage_mV", "3000"));
+  reply = Ask("quad-5", Set(3, "IN9.voltage_mV", "3000"));
   ASSERT_TRUE(reply);
-  EXPECT_EQ(reply->error(), R"(unknown signal "AIN9.voltage_mV")");
+  EXPECT_EQ(reply->error(),
+            "no signal IN9.voltage_mV; nearest: IN1.voltage_mV, IN2.voltage_mV, IN3.voltage_mV");
+  EXPECT_TRUE(reply->unknown_signal());
+  EXPECT_EQ(reply->nearest_size(), 3);
   EXPECT_EQ(reply->values_size(), 0);
 
-  reply = Ask("quad-5", Get(4, "AIN9.voltage_mV"));
+  reply = Ask("quad-5", Get(4, "IN9.voltage_mV"));
   ASSERT_TRUE(reply);
-  EXPECT_EQ(reply->error(), R"(unknown signal "AIN9.voltage_mV")");
+  EXPECT_EQ(reply->error(),
+            "no signal IN9.voltage_mV; nearest: IN1.voltage_mV, IN2.voltage_mV, IN3.voltage_mV");
+  EXPECT_TRUE(reply->unknown_signal());
+  EXPECT_EQ(reply->nearest_size(), 3);
 
-  reply = Ask("quad-5", Set(5, "AIN1.voltage_mV", "40000"));
+  reply = Ask("quad-5", Set(5, "IN1.voltage_mV", "40000"));
   ASSERT_TRUE(reply);
-  EXPECT_EQ(reply->error(), "AIN1.voltage_mV: 40000 is out of range 0..36000 mV");
+  EXPECT_EQ(reply->error(), "IN1.voltage_mV: 40000 is out of range 0..36000 mV");
 
   // Every signal: AIN1 still at 3000, and outputs are listed as such.
   reply = Ask("quad-5", Get(6, ""));
@@ -115,7 +121,7 @@ TEST_F(RemoteIo, SetAndReadBackAnInputOfARealNodeProcess) {
   EXPECT_EQ(reply->error(), "");
   bool saw_ain1 = false, saw_output = false;
   for (const auto& v : reply->values()) {
-    if (v.name() == "AIN1.voltage_mV") saw_ain1 = v.value() == "3000" && v.input();
+    if (v.name() == "IN1.voltage_mV") saw_ain1 = v.value() == "3000" && v.input();
     if (!v.input()) saw_output = true;
   }
   EXPECT_TRUE(saw_ain1);

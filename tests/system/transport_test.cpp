@@ -528,8 +528,8 @@ TEST_F(Transport, ANodeRequestReachesTheNamedNodeAndItsReplyComesBack) {
 
   std::vector<std::optional<wire::NodeReply>> replies;
   auto collect = [&](std::optional<wire::NodeReply> r) { replies.push_back(std::move(r)); };
-  server.RequestNode("can0", "quad-5", IoGetRequest(77, "AIN1.voltage_mV"), collect);
-  server.RequestNode("can0", "quad-5", IoGetRequest(77, "AIN2.voltage_mV"),
+  server.RequestNode("can0", "quad-5", IoGetRequest(77, "IN1.voltage_mV"), collect);
+  server.RequestNode("can0", "quad-5", IoGetRequest(77, "IN2.voltage_mV"),
                      collect);  // ids need not be unique
   server.RequestNode("can0", "plain", IoGetRequest(5, ""), collect);
   server.RequestNode("can0", "nobody", IoGetRequest(6, ""), collect);
@@ -548,11 +548,11 @@ TEST_F(Transport, ANodeRequestReachesTheNamedNodeAndItsReplyComesBack) {
   EXPECT_EQ(answered,
             (std::vector<std::string>{
                 R"(request_id: 5 error: "plain serves no node requests")",
-                R"(request_id: 77 values { name: "AIN1.voltage_mV" value: "2500" unit: "mV" input: true })",
-                R"(request_id: 77 values { name: "AIN2.voltage_mV" value: "2500" unit: "mV" input: true })",
+                R"(request_id: 77 values { name: "IN1.voltage_mV" value: "2500" unit: "mV" input: true })",
+                R"(request_id: 77 values { name: "IN2.voltage_mV" value: "2500" unit: "mV" input: true })",
             }));
   ASSERT_EQ(seen.size(), 2u);
-  EXPECT_NE(seen[0].find("io_get { name: \"AIN1.voltage_mV\" }"), std::string::npos) << seen[0];
+  EXPECT_NE(seen[0].find("io_get { name: \"IN1.voltage_mV\" }"), std::string::npos) << seen[0];
   EXPECT_EQ(server.Stats().node_requests, 5u);
   EXPECT_EQ(server.Stats().node_replies, 3u);
 }

@@ -1,7 +1,5 @@
 #include "tools/canfleet/cli.hpp"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <charconv>
 #include <iostream>
 #include <limits>
@@ -76,26 +74,17 @@ control::Response Call(const GlobalOptions& global, control::Request request) {
   try {
     control::ControlClient client(global.control);
     control::Response response = client.Call(std::move(request), global.timeout);
-    if (!response.error().empty()) throw CommandError(response.error());
+    if (!response.error().empty()) {
+      if (response.bad_request()) throw UsageError(response.error());
+      throw CommandError(response.error());
+    }
+    if (!response.notice().empty()) std::cerr << "canfleet: notice: " << response.notice() << '\n';
     return response;
   } catch (const control::ControlError& e) {
     throw CommandError(e.what());
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());  // a malformed --control
   }
-}
-
-void PrintJson(const google::protobuf::Message& message, bool one_line) {
-  google::protobuf::util::JsonPrintOptions options;
-  options.add_whitespace = !one_line;
-  options.always_print_primitive_fields = true;
-  options.preserve_proto_field_names = true;
-  std::string json;
-  const auto status = google::protobuf::util::MessageToJsonString(message, &json, options);
-  if (!status.ok()) throw CommandError("cannot print the response as JSON: " + status.ToString());
-  // add_whitespace ends with a newline; the one-line form does not.
-  if (!json.empty() && json.back() != '\n') json += '\n';
-  std::cout << json;
 }
 
 void PrintDone(const control::Response& response, const std::string& fallback) {

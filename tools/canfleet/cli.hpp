@@ -58,12 +58,17 @@ void AddDumpCommand(CLI::App& app, Cli& cli);
 void AddCaptureCommands(CLI::App& app, Cli& cli);
 void AddTelemetryCommands(CLI::App& app, Cli& cli);  ///< top, watch (DDS, not the control API)
 
-/// Sends `request` to the orchestrator and returns its response. Throws CommandError when it
-/// cannot be reached or answers with an error.
+/// Sends `request` to the orchestrator and returns its response; prints its notice (an old signal
+/// name, an input its pin's configuration does not read) on stderr. Throws CommandError when it
+/// cannot be reached or answers with an error, UsageError (exit 2) when it refuses the request as
+/// a bad one (Response.bad_request: an unknown node or signal, a value out of range ...).
 control::Response Call(const GlobalOptions& global, control::Request request);
 
-/// Prints `message` as JSON (protobuf's JSON mapping, field names as in the .proto, every field
-/// even when zero; 64-bit integers are strings, bytes base64), indented, or on one line.
+/// `message` as JSON (json_output.cpp): protobuf's JSON mapping (field names as in the .proto, every
+/// field even when zero, enums by name, bytes base64) except that every number is a JSON number,
+/// 64-bit integers too; indented, or on one line.
+std::string ToJson(const google::protobuf::Message& message, bool one_line = false);
+/// Prints ToJson and a newline.
 void PrintJson(const google::protobuf::Message& message, bool one_line = false);
 
 /// Prints Done.detail, or `fallback` when the orchestrator gave none.

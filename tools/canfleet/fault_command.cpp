@@ -10,6 +10,7 @@
 #include "orchestrator/control/fault_text.hpp"
 #include "tools/canfleet/cli.hpp"
 #include "tools/canfleet/text_format.hpp"
+#include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::cli {
 
@@ -87,8 +88,13 @@ CLI::Validator FaultKindValidator() {
     names += (names.empty() ? "" : ", ") + n;
   return CLI::Validator(
       [names](std::string& s) {
-        return control::ParseFaultKind(s) ? std::string()
-                                          : "unknown fault kind \"" + s + "\" (" + names + ")";
+        if (control::ParseFaultKind(s)) return std::string();
+        std::vector<std::string> kinds;
+        for (const auto& n : control::FaultKindNames())
+          kinds.emplace_back(n);
+        const auto nearest = NearestNames(s, kinds);
+        return "unknown fault kind \"" + s + "\" (" +
+               (nearest.empty() ? "" : "nearest: " + JoinNames(nearest) + "; ") + "kinds: " + names + ")";
       },
       "KIND");
 }

@@ -23,7 +23,7 @@ void AddIoCommands(CLI::App& app, Cli& cli) {
   io->require_subcommand(1);
 
   auto set_args = std::make_shared<IoArgs>();
-  CLI::App* set = io->add_subcommand("set", "Set a simulated input (AIN1.voltage_mV 2500)");
+  CLI::App* set = io->add_subcommand("set", "Set a simulated input (IN1.voltage_mV 2500)");
   set->add_option("NODE", set_args->node, "Node name")->required();
   set->add_option("NAME", set_args->name, "Signal name")->required();
   set->add_option("VALUE", set_args->value, "Value, as the signal takes it: 2500, true, open")->required();

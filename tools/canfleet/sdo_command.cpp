@@ -1,4 +1,5 @@
 // canfleet sdo read NODE INDEX SUB [TYPE], canfleet sdo write NODE INDEX SUB TYPE VALUE
+#include <cctype>
 #include <iostream>
 #include <memory>
 
@@ -17,9 +18,33 @@ struct SdoArgs {
   std::string type;
   std::string value;
   bool block = false;
-  std::uint32_t port = 0;
+  std::string port;  ///< "1", "2", "CAN1", "CAN2"; empty: CAN1
   bool json = false;
 };
+
+/// --port as the manuals print the ports (CAN1, CAN2): 1-based, or CANn. 0 was the first port
+/// before; it is refused rather than guessed.
+std::string PortError(const std::string& text) {
+  std::string digits = text;
+  if (digits.size() > 3 && (digits.rfind("CAN", 0) == 0 || digits.rfind("can", 0) == 0))
+    digits = digits.substr(3);
+  if (digits == "0")
+    return "--port " + text +
+           ": ports are numbered as the manuals print them, CAN1 and CAN2 (--port 1, --port CAN2); 0 no "
+           "longer "
+           "means the first port";
+  if (digits.empty() || digits.size() > 2 || digits.find_first_not_of("0123456789") != std::string::npos)
+    return "--port " + text + ": a CAN port, 1, 2, CAN1 or CAN2";
+  return {};
+}
+
+/// The control API's 0-based port of a valid --port.
+std::uint32_t PortIndex(const std::string& text) {
+  if (text.empty()) return 0;
+  const std::string digits =
+      text.size() > 3 && !std::isdigit(static_cast<unsigned char>(text[0])) ? text.substr(3) : text;
+  return static_cast<std::uint32_t>(std::stoul(digits) - 1);
+}
 
 CLI::Validator TypeValidator() {
   const std::string names(control::SdoTypeNames());
@@ -40,7 +65,8 @@ void AddAddress(CLI::App& cmd, SdoArgs& a) {
 
 void AddTransferOptions(CLI::App& cmd, SdoArgs& a) {
   cmd.add_flag("--block", a.block, "Use an SDO block transfer");
-  cmd.add_option("--port", a.port, "CAN port of a multi-port node (0-based)");
+  cmd.add_option("--port", a.port, "CAN port of a multi-port node, as the manual prints it: 1, 2, CAN1, CAN2")
+      ->check(CLI::Validator([](std::string& s) { return PortError(s); }, "CAN1|CAN2"));
 }
 
 int RunRead(const GlobalOptions& global, const SdoArgs& a) {
@@ -51,7 +77,7 @@ int RunRead(const GlobalOptions& global, const SdoArgs& a) {
   body->set_subindex(ParseNumber(a.subindex, "SUB", 0xFF));
   body->set_type(a.type);
   body->set_block(a.block);
-  body->set_port(a.port);
+  body->set_port(PortIndex(a.port));
   const control::Response response = Call(global, request);
   if (a.json)
     PrintJson(response.sdo());
@@ -69,7 +95,7 @@ int RunWrite(const GlobalOptions& global, const SdoArgs& a) {
   body->set_type(a.type);
   body->set_value(a.value);
   body->set_block(a.block);
-  body->set_port(a.port);
+  body->set_port(PortIndex(a.port));
   try {
     control::EncodeSdoValue(a.type, a.value);  // refuse a bad value before the orchestrator
   } catch (const control::SdoValueError& e) {

@@ -177,7 +177,7 @@ std::string FormatStatus(const control::Status& status) {
         for (int p = 0; p < n.ports_size(); ++p) {
           const auto& port = n.ports(p);
           const bool first = p == 0;
-          nodes.AddRow({first ? n.name() : "  port " + std::to_string(p + 1), first ? n.device() : "",
+          nodes.AddRow({first ? n.name() : "  CAN" + std::to_string(p + 1), first ? n.device() : "",
                         std::to_string(port.node_id()), port.bus(), first ? Process(n) : "",
                         first && n.pid() != 0 ? std::to_string(n.pid()) : (first ? "-" : ""),
                         port.nmt_state().empty() ? "-" : port.nmt_state(), ControllerText(port),

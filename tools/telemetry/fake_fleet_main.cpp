@@ -79,8 +79,8 @@ class FakeFleet {
       options.device = device;
       if (!names.empty()) options.name = names + "-" + std::to_string(node->id);
       if (io) {
-        options.inputs = {{"AIN1.voltage_V", "V"}, {"TC1.temperature_C", "C"}};
-        options.outputs = {{"POUT1.current_mA", "mA"}, {"DOUT1.on", "", {"false", "true"}}};
+        options.inputs = {{"IN1.voltage_mV", "mV"}, {"TC1.temperature_C", "C"}};
+        options.outputs = {{"OUT1.current_mA", "mA"}, {"OUT5.on", "", {"false", "true"}}};
       }
       node->status.nmt_state = NmtState::kOperational;
       node->status.heartbeat_producer_ms = 100;

@@ -37,7 +37,7 @@ std::string Consumers(const NodeStatusSample& s) {
   return text;
 }
 
-/// "AIN1.voltage_mV      1200 mV", "PS.state  on": the name in `name_width`, then the value with
+/// "IN1.voltage_mV      1200 mV", "PS.state  on": the name in `name_width`, then the value with
 /// its unit, or a bool's or an enum's word (IoValue.text: what `canfleet io get` prints).
 std::string IoCell(const telemetry::IoValueSample& v, int name_width) {
   const std::string value =

@@ -5,6 +5,7 @@
 
 #include "node/devices/datalogger_tc_analog/analog_config.hpp"
 #include "node/devices/family/family_error_policy.hpp"
+#include "node/devices/family/input_config.hpp"
 
 namespace canfleet::devices::datalogger {
 
@@ -65,7 +66,7 @@ void AnalogInputBlock::Latch() {
     Channel& c = channels_[static_cast<std::size_t>(ch)];
     const int input = ch + 1;
     c.pins.voltage_mv = io_.ain_voltage[static_cast<std::size_t>(ch)]->Number();
-    c.pins.current_ua = io_.ain_current[static_cast<std::size_t>(ch)]->Number();
+    c.pins.current_ma = io_.ain_current[static_cast<std::size_t>(ch)]->Number();
     if (input >= kFirstPulseInput && input < kFirstPulseInput + kPulseInputs) {
       const auto p = static_cast<std::size_t>(input - kFirstPulseInput);
       c.pins.frequency_hz = io_.ain_frequency[p]->Number();
@@ -107,12 +108,36 @@ blocks::AnalogInputParams AnalogInputBlock::ParamsOf(const Channel& c) const {
   return p;
 }
 
+std::string AnalogInputBlock::IgnoredInput(const IoSignal& input) const {
+  // §1.4, §3.3.4/§3.3.5: the family's rule (6112h, 6110h), family/input_config.hpp.
+  for (int ch = 0; ch < kAnalogInputs; ++ch) {
+    const auto i = static_cast<std::size_t>(ch);
+    const Channel& c = channels_[i];
+    const int input_no = ch + 1;
+    const bool pulse = input_no >= kFirstPulseInput && input_no < kFirstPulseInput + kPulseInputs;
+    const auto p = static_cast<std::size_t>(input_no - kFirstPulseInput);
+    family::InputPin pin{.channel = "IN" + std::to_string(input_no),
+                         .sub = static_cast<std::uint8_t>(input_no),
+                         .sensor_type = c.type.Get(),
+                         .mode = c.mode.Get(),
+                         .voltage = io_.ain_voltage[i],
+                         .current = io_.ain_current[i],
+                         .frequency = pulse ? io_.ain_frequency[p] : nullptr,
+                         .duty = pulse ? io_.ain_duty[p] : nullptr,
+                         .level = input_no >= kFirstUniversal
+                                      ? io_.din_level[static_cast<std::size_t>(input_no - kFirstUniversal)]
+                                      : nullptr};
+    if (pin.Has(input)) return family::IgnoredInput(input, pin);
+  }
+  return {};
+}
+
 double AnalogInputBlock::Measured(const Channel& c) const {
   switch (c.type.Get()) {
     case kSensorVoltage:
       return c.pins.voltage_mv / 1000.0;
     case kSensorCurrent:
-      return c.pins.current_ua / 1000.0;
+      return c.pins.current_ma;
     case kSensorFrequency: {
       // §3.4.5: a non-zero pulses-per-revolution turns the Hz reading into rpm.
       const auto pulses = c.pulses.Get();

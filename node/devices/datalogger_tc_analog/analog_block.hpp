@@ -8,7 +8,7 @@
 ///   unit of 6110h (V, mA, Hz or rpm with 2101h != 0 as Hz x 60 / pulses, PWM %) x 10^2102h ->
 ///   61A0h/61A1h filter called every 1 ms -> 7100h -> 2110h-2112h span check -> 7130h by
 ///   7120h-7123h. 6020h = 0 ("For all other operating modes, object 6020h will always be zero").
-/// - 10 Digital Input (inputs 8-10): the pin (DINn.level; open reads HIGH with the 2020h pull-up,
+/// - 10 Digital Input (inputs 8-10): the pin (INn.level; open reads HIGH with the 2020h pull-up,
 ///   LOW without) through 2010h polarity (Table 4: 0 normal, HIGH = ON; 1 inverse; 2 latched: each
 ///   LOW->HIGH edge toggles) -> 6020h; 7100h = 6020h (Table 10 "Digital Input 0 [On/Off]"),
 ///   7130h by 7120h-7123h, no span check. 2030h debounce (111 ns-14 us) is below the simulation's
@@ -66,6 +66,9 @@ class AnalogInputBlock {
   /// class changed and 5550h is TRUE (analog_config.hpp). `sensor_type_written`: a 6110h that
   /// differs from the one before first puts 2100h back to 0 and (not frequency/PWM) 2020h to 0.
   void OnConfigWritten(int ch, bool sensor_type_written);
+  /// Why the present 6110h/6112h do not read `input`; "" when they do or it is no input pin's
+  /// signal (the simulated I/O's ignored hook).
+  std::string IgnoredInput(const IoSignal& input) const;
   /// Re-reads every input's class without applying Table 11 (after a reset or restore).
   void RefreshClasses();
 
@@ -80,7 +83,7 @@ class AnalogInputBlock {
  private:
   struct Pins {
     double voltage_mv = 0;
-    double current_ua = 0;
+    double current_ma = 0;
     double frequency_hz = 0;
     double duty_pct = 0;
     bool level_high = false;

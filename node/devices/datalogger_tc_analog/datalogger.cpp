@@ -108,6 +108,7 @@ void DataLogger::Attach(DeviceContext& context) {
   cycle_timer_ = std::make_unique<Timer>(*scheduler_, [this] { OnCycle(); });
   conversion_timer_ = std::make_unique<Timer>(*scheduler_, [this] { OnConversion(); });
   io_.Subscribe([this](const IoSignal& signal) { OnPinChanged(signal); });
+  io_.SetIgnoredHook([this](const IoSignal& input) { return analog_->IgnoredInput(input); });
 }
 
 // ---- Reset -------------------------------------------------------------------------------------

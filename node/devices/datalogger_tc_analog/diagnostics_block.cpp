@@ -26,7 +26,7 @@ DiagnosticsBlock::DiagnosticsBlock(canopen::ObjectDictionary& od, const DataLogg
           scheduler, stacks, family::MakeFamilyEntry(kEmcyDeviceTemperature, kDescPositiveOverload, 0), 0)) {}
 
 void DiagnosticsBlock::Update() {
-  const double volts = io_.supply->Number();
+  const double volts = io_.supply->Number() / 1000.0;  // 5020h counts V
   const double celsius = io_.cpu_temperature->Number();
   supply_.SetNumber(volts);
   temperature_.SetNumber(celsius);

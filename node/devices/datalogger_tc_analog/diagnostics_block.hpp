@@ -2,7 +2,7 @@
 /// @file Supply voltage and processor temperature of the data logger (UMAX181001 §1.8, §3.4.68-
 /// 3.4.76, Table 26). Read on every application cycle; no delay is given for either fault.
 ///
-///   5020h = VPS.voltage_V (REAL32, V). With 5021h TRUE:
+///   5020h = VPS.voltage_mV / 1000 (REAL32, V). With 5021h TRUE:
 ///     V > 5023h  over-voltage  20003000h, clears at V <= 5023h - 5024h
 ///     V < 5022h  under-voltage 40003000h, clears at V >= 5022h + 5024h
 ///   5030h = TEMP.temperature_C (REAL32, C). With 5031h TRUE:

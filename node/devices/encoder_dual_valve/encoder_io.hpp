@@ -1,8 +1,8 @@
 #pragma once
 /// @file The simulated I/O of the AX023241 encoder dual valve controller (design decision 5): what a
-/// test (or `canfleet io`) puts on its pins and what it measures on its outputs. Names follow the
-/// Quad's `<CHANNEL>.<quantity>_<unit>`. Every input starts in its normal range: an idle node at
-/// factory defaults raises no fault.
+/// test (or `canfleet io`) puts on its pins and what it measures on its outputs. Names follow
+/// node/devices/README.md "Signals" (IN1/IN2, OUT1/OUT2: the manual's Input 1/2, Output 1/2). Every input
+/// starts in its normal range: an idle node at factory defaults raises no fault.
 ///
 /// Inputs
 ///   ENC.drive             rpm|counts|channels  which inputs turn the shaft (default rpm):
@@ -22,12 +22,12 @@
 ///   INn.duty_pct          0..100, 50         PWM duty cycle
 ///   OUTn.load             nominal|open|short the load on OUTn
 ///   OUTn.resistance_ohm   0.5..1000, 8       coil resistance (24 V / 8 ohm = 3 A > the 2.5 A range)
-///   VPS.voltage_V         0..70, 24          supply voltage (9..60 V operating, §4.1)
+///   VPS.voltage_mV        0..70000, 24000    supply voltage (9..60 V operating, §4.1; 5020h in V)
 ///   TEMP.temperature_C    -55..150, 25       processor temperature (5030h)
 /// Outputs
 ///   ENC.shaft_counts      the shaft position in edges since power-on
 ///   OUTn.current_mA       current through the load (= 2370h)
-///   OUTn.voltage_V        mean voltage across the load
+///   OUTn.voltage_mV       mean voltage across the load
 ///   OUTn.duty_pct         duty cycle of the high-side driver
 ///   OUTn.frequency_Hz     driver frequency (25 kHz for current/voltage, 2380h for PWM, 0 for DC)
 ///   OUTn.on               the driver is on
@@ -35,6 +35,7 @@
 ///   OUTn.tripped          the short-circuit protection has the driver off (1.5, retrying)
 
 #include <array>
+#include <vector>
 
 #include "node/devices/encoder_dual_valve/encoder_objects.hpp"
 #include "node/devices/simulated_io.hpp"
@@ -81,6 +82,10 @@ struct EncoderIo {
   std::array<IoSignal*, kOutputs> hotshot{};
   std::array<IoSignal*, kOutputs> tripped{};
 };
+
+/// The old names of the encoder controller's signals (VPS.voltage_V, OUTn.voltage_V) and their new
+/// ones; the one table, registered by EncoderIo.
+std::vector<IoAlias> EncoderSignalAliases();
 
 /// The catalog's signal declaration (registry.hpp `declare_signals`).
 void DeclareEncoderSignals(SimulatedIo& io);

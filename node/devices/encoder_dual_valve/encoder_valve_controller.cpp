@@ -93,6 +93,7 @@ void EncoderValveController::Attach(DeviceContext& context) {
     }
   }
   InstallWakeListeners();
+  io_.SetIgnoredHook([this](const IoSignal& input) { return inputs_->IgnoredInput(input); });
   subscription_ = io_.Subscribe([this](const IoSignal& signal) {
     if (signal.direction() != IoDirection::kInput) return;
     inputs_->OnSignal(signal, scheduler_->Now());

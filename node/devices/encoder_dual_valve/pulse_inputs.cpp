@@ -71,6 +71,55 @@ InputMode PulseInputs::Mode(int ch) const {
   return InputMode::kOff;
 }
 
+std::string PulseInputs::IgnoredInput(const IoSignal& input) const {
+  const bool by_channels = io_.drive->Is(kDriveChannels);
+  for (int ch = 0; ch < kInputs; ++ch) {
+    const InputMode mode = Mode(ch);
+    bool read = false;
+    if (&input == io_.level[ch])
+      read = mode == InputMode::kDigital;
+    else if (&input == io_.frequency[ch])
+      read = mode == InputMode::kFrequency || mode == InputMode::kPwm || (by_channels && PairIsQuadrature());
+    else if (&input == io_.duty[ch])
+      read = mode == InputMode::kPwm;
+    else
+      continue;
+    if (read) return {};
+    const std::string sub = std::to_string(ch + 1);
+    const char* reads = "it reads none of the pin's signals";
+    switch (mode) {
+      case InputMode::kDigital:
+        reads = "it reads the pin's level";
+        break;
+      case InputMode::kFrequency:
+        reads = "it reads the pin's frequency";
+        break;
+      case InputMode::kPwm:
+        reads = "it reads the pin's duty cycle and frequency";
+        break;
+      case InputMode::kQuadrature:
+        reads =
+            "a quadrature pair turns with ENC.drive: ENC.speed_rpm, ENC.speed_counts_s, or INn.frequency_Hz "
+            "when ENC.drive = channels";
+        break;
+      case InputMode::kOff:
+        break;
+    }
+    return IgnoredNotice(input,
+                         "IN" + sub + "'s configuration (6112h sub " + sub + " = " +
+                             std::to_string(refs_[ch].mode.Get()) + ", 6110h sub " + sub + " = " +
+                             std::to_string(refs_[ch].sensor_type.Get()) + ")",
+                         reads);
+  }
+  const bool rpm = io_.drive->Is(kDriveRpm);
+  if ((&input == io_.speed_rpm || &input == io_.pulses_per_rev) && !rpm)
+    return IgnoredNotice(input, "ENC.drive = " + std::string(io_.drive->Enum()), "ENC.drive = rpm reads it");
+  if (&input == io_.speed_counts && !io_.drive->Is(kDriveCounts))
+    return IgnoredNotice(input, "ENC.drive = " + std::string(io_.drive->Enum()),
+                         "ENC.drive = counts reads it");
+  return {};
+}
+
 QuadratureParams PulseInputs::Quadrature() const {
   QuadratureParams q;
   q.scaler = qd_scaler_.GetNumber();

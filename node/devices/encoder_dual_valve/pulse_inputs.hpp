@@ -74,6 +74,9 @@ class PulseInputs {
   std::optional<Ms> NextChange(const std::array<bool, kInputs>& consumed) const;
 
   InputMode Mode(int ch) const;
+  /// Why the present configuration (6110h, 6112h, ENC.drive) does not read `input`; "" when it
+  /// does or the signal is not an input's (the simulated I/O's ignored hook).
+  std::string IgnoredInput(const IoSignal& input) const;
   /// Power-on / reset node: filters and span flags cleared, the step counter zeroed.
   void Reset(TimePoint now);
   /// 6110h or 2100h was written: the step counter starts again from 0 (quadrature.hpp).

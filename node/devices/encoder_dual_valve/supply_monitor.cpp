@@ -50,7 +50,7 @@ void SupplyMonitor::Step(State& s, bool enabled, bool set, bool clear, Ms delay,
 }
 
 void SupplyMonitor::Update(Ms elapsed) {
-  supply_V_ = io_.supply->Number();
+  supply_V_ = io_.supply->Number() / 1000.0;  // 5020h counts V
   const double celsius = io_.temperature->Number();
   supply_.SetNumber(supply_V_);
   temperature_.SetNumber(celsius);

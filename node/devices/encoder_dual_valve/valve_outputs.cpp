@@ -111,7 +111,7 @@ void ValveOutputs::Update(Ms elapsed, const OutputConditions& conditions,
                        (can_controlled && conditions.nmt != canopen::NmtState::kOperational);
 
     LoadModel load;
-    load.supply_V = io_.supply->Number();
+    load.supply_V = io_.supply->Number() / 1000.0;
     const IoSignal& state = *io_.load[n];
     load.load = state.Is(kLoadOpen)    ? LoadState::kOpen
                 : state.Is(kLoadShort) ? LoadState::kShort
@@ -144,7 +144,7 @@ void ValveOutputs::Publish(int n) {
   const DriveOutput& out = drives_[n].Output();
   SimulatedIo& io = io_.io;
   io.Publish(*io_.current[n], out.current_mA);
-  io.Publish(*io_.voltage[n], out.voltage_V);
+  io.Publish(*io_.voltage[n], out.voltage_V * 1000.0);
   io.Publish(*io_.out_duty[n], out.duty_pct);
   io.Publish(*io_.out_frequency[n], out.frequency_Hz);
   io.Publish(*io_.on[n], out.on);

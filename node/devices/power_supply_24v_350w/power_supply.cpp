@@ -21,9 +21,9 @@ std::int64_t Round(double value) {
   return std::llround(value);
 }
 
-/// Millivolt/milliampere resolution for the simulated outputs (the objects' resolution, §1.2.3).
+/// V and A to the signals' mV and mA, at the objects' resolution (§1.2.3).
 double Milli(double value) {
-  return std::round(value * 1000.0) / 1000.0;
+  return std::round(value * 1000.0);
 }
 
 std::uint32_t Flag(bool on, unsigned shift) {
@@ -76,6 +76,7 @@ void PowerSupply::Attach(DeviceContext& context) {
   scheduler_ = &context.scheduler;
   auto& od = stack_->od();
   using namespace ps;
+  io_.SetIgnoredHook([this](const IoSignal& input) { return signals_.IgnoredInput(input); });
 
   filter_type_ = OdRef(od, kInputFilterType, 1);
   filter_constant_ = OdRef(od, kInputFilterConstant, 1);
@@ -180,7 +181,7 @@ void PowerSupply::InstallListeners() {
 // Power-on and NMT reset node: the stack has restored the parameters and forgotten its errors.
 void PowerSupply::OnResetApplication() {
   if (!control_) return;
-  const double vin = signals_.vin->Number();
+  const double vin = signals_.vin->Number() / 1000.0;
   control_->Reset(signals_.enable->Is(ps::kLevelHigh));
   input_status_->Reset();
   output_status_->Reset();
@@ -231,7 +232,7 @@ ps::Load PowerSupply::CurrentLoad() const {
   ps::Load load;
   load.is_resistance = signals_.load_mode->Is(ps::kLoadResistance);
   load.resistance_ohm = signals_.load_resistance->Number();
-  load.current_A = signals_.load_current->Number();
+  load.current_A = signals_.load_current->Number() / 1000.0;
   return load;
 }
 
@@ -285,7 +286,7 @@ void PowerSupply::Step() {
   // Inputs: one sample per tick. A filter settled on the present input is left alone: another
   // sample would change nothing but the phase of the repeating average's blocks, so a block
   // starts with the first sample after a steady period (README.md choice 9).
-  const double vin = signals_.vin->Number();
+  const double vin = signals_.vin->Number() / 1000.0;
   const blocks::FilterParams params = FilterParams();
   if (!filter_.Settled(params, vin * 1000.0)) filter_.Step(params, vin * 1000.0);
   const auto protection_before = protection_.state();

@@ -152,7 +152,8 @@ int AiBlock::Measure(int ch) const {
       return ch < kAnalogInputs ? ClampToScale(io_.ain_voltage[ch]->Number(), type) : 0;
     case SensorType::kCurrent4To20:
     case SensorType::kCurrent0To20:
-      return ch < kAnalogInputs ? ClampToScale(io_.ain_current[ch]->Number(), type) : 0;
+      return ch < kAnalogInputs ? ClampToScale(io_.ain_current[ch]->Number() * 1000.0, type)
+                                : 0;  // 7100h: uA
     case SensorType::kPwm:
       return ch >= kAnalogInputs ? ClampToScale(io_.fin_duty[ch - kAnalogInputs]->Number() * 100.0, type) : 0;
     case SensorType::kFrequency:

@@ -1,6 +1,7 @@
 #include "node/devices/quad_controller/quad_controller.hpp"
 
 #include "node/devices/eds_dictionary.hpp"
+#include "node/devices/family/input_config.hpp"
 #include "node/devices/quad_controller/quad_error_policy.hpp"
 #include "node/devices/quad_controller/quad_objects.hpp"
 #include "node/devices/quad_controller/quad_validators.hpp"
@@ -71,8 +72,39 @@ void QuadController::Attach(DeviceContext& context) {
   output_tick_ = std::make_unique<PeriodicTick>(
       context.scheduler, kOutputPeriod, [this] { OnOutputTick(); }, [this] { return !output_changed_; });
   WakeOnChanges(*stack_, io_, [this] { WakeTicks(); });
+  io_.SetIgnoredHook([this](const IoSignal& input) { return IgnoredInput(input); });
   sample_tick_->Start();
   output_tick_->Start();
+}
+
+std::string QuadController::IgnoredInput(const IoSignal& input) const {
+  // §3.3.13/§3.3.14: the family's rule (6112h, 6110h), family/input_config.hpp.
+  for (int ch = 0; ch < quad::kInputs; ++ch) {
+    const bool analog = ch < quad::kAnalogInputs;
+    const std::size_t f = static_cast<std::size_t>(ch - quad::kAnalogInputs);
+    family::InputPin pin{.channel = "IN" + std::to_string(quad::SubOf(ch)),
+                         .sub = quad::SubOf(ch),
+                         .sensor_type = static_cast<std::int64_t>(ai_->Type(ch)),
+                         .mode = static_cast<std::int64_t>(ai_->Mode(ch)),
+                         .voltage = analog ? signals_.ain_voltage[ch] : nullptr,
+                         .current = analog ? signals_.ain_current[ch] : nullptr,
+                         .frequency = analog ? nullptr : signals_.fin_frequency[f],
+                         .duty = analog ? nullptr : signals_.fin_duty[f],
+                         .level = signals_.din_level[ch]};
+    if (pin.Has(input)) return family::IgnoredInput(input, pin);
+  }
+  for (int o = 0; o < quad::kPouts; ++o) {
+    if (&input != signals_.pout_load_current[o]) continue;
+    // §3.5.15: only a digital output (6310h = 1000) passes the load's own current.
+    const auto* type = stack_->od().Find(quad::kAoOutputType, quad::SubOf(o));
+    const auto value = type ? canopen::DecodeUnsignedLe(type->value) : 0;
+    if (value == static_cast<std::uint64_t>(quad::OutputType::kDigital)) return {};
+    const std::string sub = std::to_string(quad::SubOf(o));
+    return IgnoredNotice(
+        input, "OUT" + sub + "'s configuration (6310h sub " + sub + " = " + std::to_string(value) + ")",
+        "6310h sub " + sub + " = 1000 reads it");
+  }
+  return {};
 }
 
 void QuadController::OnSample() {

@@ -53,6 +53,8 @@ class QuadController final : public Device {
   void OnOutputTick();
   void OnResetApplication();
   void WakeTicks();
+  /// The simulated I/O's ignored hook: why the present 6110h/6112h/6310h do not read `input`.
+  std::string IgnoredInput(const IoSignal& input) const;
 
   DeviceOptions options_;
   quad::QuadIo signals_;

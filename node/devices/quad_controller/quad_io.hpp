@@ -1,25 +1,29 @@
 #pragma once
 /// @file The Quad's simulated I/O (AX020506 §1.1, §1.2, Appendix A): what a test can put on the
-/// pins and what it can measure on the outputs.
+/// pins and what it can measure on the outputs. Names follow node/devices/README.md "Signals":
+/// IN1-IN6 are the manual's AIN1-4 and FIN1-2 (DIN1-6 as digital inputs), OUT1-OUT5 its POUT1-4
+/// and DOUT, as the sub-indices of the per-channel objects number them.
 ///
 /// Inputs (defaults in the normal range: an idle node raises no faults):
-///   AINn.voltage_mV   0..36000, 2500   voltage on AINn (read when 6110h.n = 40 or 42)
-///   AINn.current_uA   0..40000, 12000  current into AINn (read when 6110h.n = 51 or 52)
-///   FINn.duty_pct     0..100, 50       duty cycle on FINn (6110h = 10000, PWM)
-///   FINn.frequency_Hz 0..50000, 1000   frequency on FINn (6110h = 60)
-///   DINn.level        open|high|low    the pin as a digital input (6112h = 10); DIN1-4 = AIN1-4,
-///                                      DIN5-6 = FIN1-2; open = floating, 2000h's pull decides
-///   POUTn.load        nominal|open|short  the load on POUTn
-///   POUTn.load_current_mA 0..2000, 1000 what the load draws when POUTn is switched on as a
-///                                      digital output (6310h = 1000)
-///   DOUT.load         nominal|open|short
+///   INn.voltage_mV      n = 1..4  0..36000, 2500  voltage at the pin (read when 6110h.n = 40 or 42)
+///   INn.current_mA      n = 1..4  0..40, 12       current into the pin (6110h.n = 51 or 52; 7100h in uA)
+///   INn.duty_pct        n = 5, 6  0..100, 50      duty cycle (6110h = 10000, PWM)
+///   INn.frequency_Hz    n = 5, 6  0..50000, 1000  frequency (6110h = 60)
+///   INn.level           n = 1..6  open|high|low   the pin as a digital input (6112h = 10); open =
+///                                                 floating, 2000h's pull decides
+///   OUTn.load           n = 1..5  nominal|open|short  the load on the output
+///   OUTn.load_current_mA n = 1..4 0..2000, 1000  what the load draws when OUTn is switched on as a
+///                                                 digital output (6310h = 1000)
 /// Outputs:
-///   POUTn.current_mA  the current through the load (= 30C0h)
-///   POUTn.on          the driver is on (and not shut off by its short-circuit protection)
-///   POUTn.dither_mA, POUTn.dither_Hz  dither superimposed on the current (0 when none)
-///   DOUT.on           the DOUT driver is on
+///   OUTn.current_mA     n = 1..4  the current through the load (= 30C0h)
+///   OUTn.on             n = 1..5  the driver is on (and not shut off by its short-circuit protection)
+///   OUTn.dither_mA, OUTn.dither_Hz  n = 1..4  dither superimposed on the current (0 when none)
+/// Setting a quantity the pin's configuration does not read is accepted with a notice
+/// (QuadController's ignored hook). The old names (AIN1.voltage_mV, POUT1.current_mA ...):
+/// QuadSignalAliases.
 
 #include <array>
+#include <vector>
 
 #include "node/devices/quad_controller/quad_objects.hpp"
 #include "node/devices/simulated_io.hpp"
@@ -55,5 +59,9 @@ struct QuadIo {
   std::array<IoSignal*, kPouts> pout_dither_frequency{};
   IoSignal* dout_on = nullptr;
 };
+
+/// The old names of the Quad's signals (AINn, FINn, DINn, POUTn, DOUT) and their new ones; the one
+/// table, registered by QuadIo.
+std::vector<IoAlias> QuadSignalAliases();
 
 }  // namespace canfleet::devices::quad

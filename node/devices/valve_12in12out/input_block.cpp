@@ -113,7 +113,7 @@ double InputBlock::Measure(int ch, const Key& key) const {
     case SensorType::kVoltage:
       return number(io_.voltage[ch]) / 1000.0;  // V
     case SensorType::kCurrent:
-      return number(io_.current[ch]) / 1000.0;  // mA
+      return number(io_.current[ch]);  // mA
     case SensorType::kResistive:
       return number(io_.resistance[ch]) / 1000.0;  // kOhm (FV 0.01 kOhm with 2 digits)
     case SensorType::kFrequency: {

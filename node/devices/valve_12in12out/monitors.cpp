@@ -21,7 +21,7 @@ Monitors::Monitors(canopen::CanopenStack& stack, Scheduler& scheduler, const Val
                          family::MakeFamilyEntry(kEmcyTemperature, kDescPositiveOverload, 0), 0) {}
 
 void Monitors::Run() {
-  const double volts = io_.supply->Number();
+  const double volts = io_.supply->Number() / 1000.0;  // 5020h counts V
   const double celsius = io_.temperature->Number();
   voltage_.SetNumber(volts);
   temperature_.SetNumber(celsius);

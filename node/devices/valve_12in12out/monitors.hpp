@@ -2,7 +2,7 @@
 /// @file Supply voltage and processor temperature monitoring (UMAX020411A §1.10, §3.4.99-3.4.107,
 /// §3.2.4 Table 33).
 ///
-/// - 5020h (REAL32 V) and 5030h (REAL32 degC) follow the simulated VPS.voltage_V and
+/// - 5020h (REAL32 V) and 5030h (REAL32 degC) follow the simulated VPS.voltage_mV (/1000) and
 ///   TEMP.temperature_C.
 /// - Supply (5021h TRUE): below 5022h -> under-voltage 40003000h, above 5023h -> over-voltage
 ///   20003000h (EMCY 3000h "generic voltage"); under clears at 5022h + 5024h or more, over at

@@ -282,7 +282,7 @@ void OutputBlock::Publish(int ch, TimePoint now) {
   const bool shorted = load.Is(kLoadShort);
   const double unit =
       blocks::PowerOfTen(static_cast<std::uint8_t>(std::clamp<std::int64_t>(r.fv_digits.Get(), 0, 4)));
-  const double supply_mV = io_.supply->Number() * 1000.0;
+  const double supply_mV = io_.supply->Number();
   double current_mA = 0;
   double voltage_mV = 0;
   double duty = 0;

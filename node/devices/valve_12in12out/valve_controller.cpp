@@ -5,6 +5,7 @@
 
 #include "node/devices/eds_dictionary.hpp"
 #include "node/devices/family/family_error_policy.hpp"
+#include "node/devices/family/input_config.hpp"
 #include "node/devices/valve_12in12out/input_block.hpp"
 #include "node/devices/valve_12in12out/monitors.hpp"
 #include "node/devices/valve_12in12out/output_block.hpp"
@@ -102,8 +103,40 @@ void ValveController::Attach(DeviceContext& context) {
   od.AddWriteListener([this](SubObject& sub, Origin origin) {
     if (origin != Origin::kDevice && sub.index >= 0x2000 && sub.index <= 0x7FFF) RequestRun();
   });
+  io_.SetIgnoredHook([this](const IoSignal& input) { return IgnoredInput(input); });
   last_run_ = FloorMs(context.scheduler.Now());
   RequestRun();
+}
+
+std::string ValveController::IgnoredInput(const IoSignal& input) const {
+  using namespace valve;
+  // §2.1 Tables 4 and 5: the family's rule (6112h, 6110h), family/input_config.hpp.
+  for (int ch = 0; ch < kInputs; ++ch) {
+    const auto sub = static_cast<std::uint8_t>(ch + 1);
+    family::InputPin pin{.channel = "IN" + std::to_string(sub),
+                         .sub = sub,
+                         .sensor_type = static_cast<std::int64_t>(od_->GetUnsigned(kAiSensorType, sub)),
+                         .mode = static_cast<std::int64_t>(od_->GetUnsigned(kAiMode, sub)),
+                         .voltage = signals_.voltage[ch],
+                         .current = signals_.current[ch],
+                         .resistance = signals_.resistance[ch],
+                         .frequency = signals_.frequency[ch],
+                         .duty = signals_.duty[ch],
+                         .level = signals_.level[ch]};
+    if (pin.Has(input)) return family::IgnoredInput(input, pin);
+  }
+  for (int ch = 0; ch < kOutputs; ++ch) {
+    if (&input != signals_.load_current[ch]) continue;
+    // §1.4 Table 14: only an on/off output (6310h = 1000) passes the load's own current.
+    const auto sub = static_cast<std::uint8_t>(ch + 1);
+    const auto type = od_->GetUnsigned(kAoType, sub);
+    if (type == static_cast<std::uint64_t>(OutputType::kDigital)) return {};
+    return IgnoredNotice(input,
+                         "OUT" + std::to_string(sub) + "'s configuration (6310h sub " + std::to_string(sub) +
+                             " = " + std::to_string(type) + ")",
+                         "6310h sub " + std::to_string(sub) + " = 1000 reads it");
+  }
+  return {};
 }
 
 bool ValveController::Idle() const {

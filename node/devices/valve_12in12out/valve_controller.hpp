@@ -68,6 +68,8 @@ class ValveController final : public Device {
   void Run();
   void OnResetApplication();
   void OnCommError(const canopen::CommError& error, bool active);
+  /// The simulated I/O's ignored hook: why the present 6110h/6112h/6310h do not read `input`.
+  std::string IgnoredInput(const IoSignal& input) const;
 
   DeviceOptions options_;
   valve::ValveIo signals_;

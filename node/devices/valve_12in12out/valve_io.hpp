@@ -1,35 +1,35 @@
 #pragma once
 /// @file The valve controller's simulated I/O (UMAX020411A §1.1, §2.1, §4 "Input/Output
-/// Specifications"): what a test can put on the pins and what it can measure on the outputs.
+/// Specifications"): what a test can put on the pins and what it can measure on the outputs. Names
+/// follow node/devices/README.md "Signals": IN1-IN12 and OUT1-OUT12 as the sub-indices of every
+/// 12-entry I/O object number them (IN1-7 = the manual's UI1-7, IN8-12 = DI1-5; OUT9-12 = DO1-4).
 ///
 /// Inputs (defaults inside every default range: an idle node at factory defaults raises no fault):
-///   UIn.voltage_mV     n = 1..7   0..36000, 2500   voltage at UIn (6110h = 40). The manual's
+///   INn.voltage_mV     n = 1..7   0..36000, 2500   voltage at the pin (6110h = 40). The manual's
 ///                                 defaults (span start 200 mV, 2110h TRUE) would make an open input
 ///                                 at 0 V raise 40nnF001h after 1 s: the pins default mid-range.
-///   UIn.current_uA     n = 1..7   0..30000, 12000  current into UIn (6110h = 50; FV in mA)
-///   UIn.resistance_ohm n = 1..6   0..300000, 10000 resistance at UIn (6110h = 11000)
-///   UIn.frequency_Hz   n = 1,3,5,7  0..50000, 1000 frequency at UIn (6110h = 60; RPM with 2101h)
-///   UIn.duty_pct       n = 1,3,5,7  0..100, 50     PWM duty cycle at UIn (6110h = 10000)
-///   UIn.level          n = 1..7   open|high|low   the pin read as a digital input (6112h = 10)
-///   DIn.level          n = 1..5   open|high|low   DI1-DI5 as digital inputs (default mode)
-///   DIn.frequency_Hz, DIn.duty_pct  n = 1,3,5     DI1/3/5 as frequency / PWM inputs
-///   VPS.voltage_V      0..70, 24                  supply voltage (5020h)
+///   INn.current_mA     n = 1..7   0..30, 12        current into the pin (6110h = 50; FV in mA)
+///   INn.resistance_ohm n = 1..6   0..300000, 10000 resistance at the pin (6110h = 11000)
+///   INn.frequency_Hz   n = 1,3,5,7,8,10,12  0..50000, 1000  frequency (6110h = 60; RPM with 2101h)
+///   INn.duty_pct       n = 1,3,5,7,8,10,12  0..100, 50      PWM duty cycle (6110h = 10000)
+///   INn.level          n = 1..12  open|high|low   the pin read as a digital input (6112h = 10;
+///                                 the default of IN8-12)
+///   VPS.voltage_mV     0..70000, 24000            supply voltage (5020h, in V)
 ///   TEMP.temperature_C -50..150, 40               processor temperature (5030h)
-///   OUTn.load          n = 1..8   nominal|open|short  the load on OUTn
-///   OUTn.load_current_mA n = 1..8 0..3000, 1000  what the load draws when OUTn is switched on as an
+///   OUTn.load          n = 1..12  nominal|open|short  the load on the output
+///   OUTn.load_current_mA n = 1..12 0..3000, 1000 what the load draws when OUTn is switched on as an
 ///                                 on/off digital output (6310h = 1000)
-///   DOn.load           n = 1..4   nominal|open|short
-///   DOn.load_current_mA n = 1..4  0..3000, 1000
 /// Outputs:
-///   OUTn.on            the driver is on (not shut off by short-circuit protection)
-///   OUTn.current_mA    current through the load (current, hotshot and digital types)
-///   OUTn.voltage_mV    average voltage at the pin (voltage type: the FV up to the supply; PWM and
-///                      digital: duty x supply)
-///   OUTn.duty_pct      PWM duty cycle of the driver (PWM type: the FV; voltage: FV / supply)
-///   OUTn.dither_mA, OUTn.dither_Hz  dither on a current output (2320h/2321h; 0 when none)
-///   DOn.on, DOn.current_mA
+///   OUTn.on            n = 1..12  the driver is on (not shut off by short-circuit protection)
+///   OUTn.current_mA    n = 1..12  current through the load (current, hotshot and digital types)
+///   OUTn.voltage_mV    n = 1..8   average voltage at the pin (voltage type: the FV up to the supply;
+///                                 PWM and digital: duty x supply)
+///   OUTn.duty_pct      n = 1..8   PWM duty cycle of the driver (PWM type: the FV; voltage: FV / supply)
+///   OUTn.dither_mA, OUTn.dither_Hz  n = 1..8  dither on a current output (2320h/2321h; 0 when none)
+/// The old names (UIn, DIn, DOn, VPS.voltage_V): ValveSignalAliases.
 
 #include <array>
+#include <vector>
 
 #include "node/devices/simulated_io.hpp"
 #include "node/devices/valve_12in12out/valve_objects.hpp"
@@ -73,6 +73,9 @@ struct ValveIo {
   std::array<IoSignal*, kOutputs> dither_amplitude{};
   std::array<IoSignal*, kOutputs> dither_frequency{};
 };
+
+/// The old names of the valve's signals and their new ones; the one table, registered by ValveIo.
+std::vector<IoAlias> ValveSignalAliases();
 
 /// The catalog's signal declaration: declares the valve's signals into an empty SimulatedIo.
 void DeclareValveSignals(SimulatedIo& io);

@@ -107,19 +107,19 @@ TEST_F(NodeTelemetryWiringTest, StatusFollowsTheNmtState) {
 
 // Design decision 5: the simulated I/O, with names and units, and every change of an input.
 TEST_F(NodeTelemetryWiringTest, IoSnapshotCarriesTheSimulatedIoAndItsChanges) {
-  ASSERT_TRUE(monitor_.Until([&] { return monitor_.Input(kNodeId, "AIN1.voltage_mV") == 2500.0; }));
+  ASSERT_TRUE(monitor_.Until([&] { return monitor_.Input(kNodeId, "IN1.voltage_mV") == 2500.0; }));
   const auto& io = *monitor_.Node(kNodeId)->io;
   EXPECT_EQ(io.inputs.size() + io.outputs.size(), node_->io().Signals().size());
-  EXPECT_EQ(io.inputs[0], (telemetry::IoValueSample{"AIN1.voltage_mV", 2500.0, "mV"}));
+  EXPECT_EQ(io.inputs[0], (telemetry::IoValueSample{"IN1.voltage_mV", 2500.0, "mV"}));
 
-  ASSERT_TRUE(node_->io().SetNumber("AIN1.voltage_mV", 3100).ok());
-  ASSERT_TRUE(monitor_.Until([&] { return monitor_.Input(kNodeId, "AIN1.voltage_mV") == 3100.0; }));
+  ASSERT_TRUE(node_->io().SetNumber("IN1.voltage_mV", 3100).ok());
+  ASSERT_TRUE(monitor_.Until([&] { return monitor_.Input(kNodeId, "IN1.voltage_mV") == 3100.0; }));
 }
 
 // Quad §4.1: a short on DOUT is FF02h (channel 05h, description 02h) after the 300Bh sub 5 delay
 // (1000 ms); the EMCY is published with its bytes and 1001h bit 0 reaches the status.
 TEST_F(NodeTelemetryWiringTest, EveryEmcySentIsPublishedWithTheStatusItChanged) {
-  ASSERT_TRUE(node_->io().SetEnum("DOUT.load", "short").ok());
+  ASSERT_TRUE(node_->io().SetEnum("OUT5.load", "short").ok());
   scheduler_.Advance(1100ms);
   ASSERT_EQ(master_.Take().empty(), false);
   ASSERT_TRUE(monitor_.Until([&] { return monitor_.HasEmcy(0xFF02); }));
@@ -136,7 +136,7 @@ TEST_F(NodeTelemetryWiringTest, EveryEmcySentIsPublishedWithTheStatusItChanged) 
   }));
 
   // Repaired: the error reset (0000h) and 1001h back to 0.
-  ASSERT_TRUE(node_->io().SetEnum("DOUT.load", "nominal").ok());
+  ASSERT_TRUE(node_->io().SetEnum("OUT5.load", "nominal").ok());
   scheduler_.Advance(20ms);
   ASSERT_TRUE(monitor_.Until(
       [&] { return monitor_.HasEmcy(0x0000) && monitor_.Node(kNodeId)->status.error_register == 0; }));
@@ -210,7 +210,7 @@ TEST_F(NodeTelemetryWiringTest, DestroyingTheWiringDisposesTheNode) {
   ASSERT_TRUE(monitor_.Until([&] { return !monitor_.Node(kNodeId)->alive; }));
   EXPECT_TRUE(monitor_.Node(kNodeId)->disposed);
   // The hooks and listeners it left behind are no-ops now.
-  ASSERT_TRUE(node_->io().SetNumber("AIN1.voltage_mV", 3000).ok());
+  ASSERT_TRUE(node_->io().SetNumber("IN1.voltage_mV", 3000).ok());
   master_.Send("000#0105");
   scheduler_.Advance(2000ms);
 }

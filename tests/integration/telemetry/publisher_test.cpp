@@ -142,8 +142,8 @@ TEST(NodeTelemetry, IoValuesCarryTheirNamesAndUnits) {
   Participant participant(TestDds(17));
   Collector monitor(participant);
   auto options = Options("io", 60s);
-  options.inputs = {{"AIN1.voltage_V", "V"}, {"TC2.temperature_C", "C"}};
-  options.outputs = {{"POUT1.current_mA", "mA"}};
+  options.inputs = {{"IN1.voltage_mV", "mV"}, {"TC2.temperature_C", "C"}};
+  options.outputs = {{"OUT1.current_mA", "mA"}};
   NodeTelemetry telemetry(participant, options);
   telemetry.UpdateStatus({});
   const double in[] = {4.5, 21.0};
@@ -155,7 +155,7 @@ TEST(NodeTelemetry, IoValuesCarryTheirNamesAndUnits) {
   ASSERT_EQ(io.inputs.size(), 2u);
   EXPECT_EQ(io.inputs[1], (IoValueSample{"TC2.temperature_C", 21.0, "C"}));
   ASSERT_EQ(io.outputs.size(), 1u);
-  EXPECT_EQ(io.outputs[0], (IoValueSample{"POUT1.current_mA", 350.0, "mA"}));
+  EXPECT_EQ(io.outputs[0], (IoValueSample{"OUT1.current_mA", 350.0, "mA"}));
 }
 
 TEST(NodeTelemetry, DestroyingThePublisherDisposesTheNode) {

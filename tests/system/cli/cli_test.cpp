@@ -284,6 +284,7 @@ TEST_F(CanfleetCli, StatusJsonIsTheStatusMessage) {
   EXPECT_TRUE(Same(parsed, status)) << run.out;
   EXPECT_NE(run.out.find("\"load_percent\": 12.5"), std::string::npos) << "field names as in the .proto";
   EXPECT_NE(run.out.find("\"error_frames_per_s\": 0"), std::string::npos) << "zero fields are printed too";
+  EXPECT_NE(run.out.find("\"frames\": 10234,"), std::string::npos) << "64-bit counters are JSON numbers";
 }
 
 TEST_F(CanfleetCli, AnOrchestratorErrorExitsWithOneAndItsMessage) {
@@ -347,7 +348,14 @@ TEST_F(CanfleetCli, BadArgumentsExitWithTwoAndSendNothing) {
       {"--timeout", "5", "status"},
       {"nmt", "jump"},
       {"fault", "inject", "kill", "quad-5", "--node", "quad-6"},
+      {"fault", "inject", "bus-of", "quad-5"},
       {"dump", "can0", "--bus", "can1"},
+      {"sdo", "read", "datalogger", "0x1017", "0", "--port", "0"},
+      {"sdo", "read", "datalogger", "0x1017", "0", "--port", "CAN0"},
+      {"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "two"},
+      {"io", "set", "quad-5", "IN1.voltage_mV"},
+      {"io", "get"},
+      {"status", "--jsn"},
   };
   for (const auto& args : kBad) {
     std::string joined;
@@ -372,6 +380,54 @@ TEST_F(CanfleetCli, BadArgumentMessagesSayWhatToWrite) {
       << run.err;
   run = Canfleet({"fault", "clear"});
   EXPECT_NE(run.err.find("say which fault: an ID, --label LABEL or --all"), std::string::npos) << run.err;
+}
+
+// The ports as the manuals print them (CAN1, CAN2): 0 used to be the first port and is refused
+// with the reason rather than guessed.
+TEST_F(CanfleetCli, PortsAreCan1AndCan2AndZeroIsRefusedWithTheReason) {
+  const Outcome run = Canfleet({"sdo", "read", "datalogger", "0x1017", "0", "--port", "0"});
+  EXPECT_EQ(run.exit, 2);
+  EXPECT_NE(run.err.find("ports are numbered as the manuals print them, CAN1 and CAN2"), std::string::npos)
+      << run.err;
+  handler_.SetAnswer([](const Request&) { return Done("written"); });
+  EXPECT_EQ(Canfleet({"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "2"}).exit, 0);
+  EXPECT_EQ(handler_.Requests().back().sdo_write().port(), 1u);
+  EXPECT_EQ(Canfleet({"sdo", "write", "datalogger", "0x1017", "0", "u16", "1", "--port", "CAN1"}).exit, 0);
+  EXPECT_EQ(handler_.Requests().back().sdo_write().port(), 0u);
+}
+
+// What the orchestrator refuses as a bad request (an unknown node or signal, a value a signal
+// refuses, a fault without what its kind needs) is a bad argument too: exit 2, its message (with
+// the nearest names) on stderr. A failure of the fleet stays exit 1 (above).
+TEST_F(CanfleetCli, ABadRequestTheOrchestratorRefusesExitsWithTwo) {
+  handler_.SetAnswer([](const Request&) {
+    Response r = Error(
+        "no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV; all: canfleet io get "
+        "quad-5");
+    r.set_bad_request(true);
+    return r;
+  });
+  const Outcome run = Canfleet({"io", "set", "quad-5", "IN9.voltage_mV", "1"});
+  EXPECT_EQ(run.exit, 2);
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(
+      run.err,
+      "canfleet: no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV; all: canfleet "
+      "io get quad-5\n");
+}
+
+// A done request with a notice (an old signal name, a quantity the pin's configuration does not
+// read): done (exit 0, the usual line on stdout), the notice on stderr.
+TEST_F(CanfleetCli, ANoticeGoesToStderrAndTheCommandSucceeds) {
+  handler_.SetAnswer([](const Request&) {
+    Response r = Done("quad-5 AIN1.voltage_mV = 1800");
+    r.set_notice("AIN1.voltage_mV is deprecated: use IN1.voltage_mV");
+    return r;
+  });
+  const Outcome run = Canfleet({"io", "set", "quad-5", "AIN1.voltage_mV", "1800"});
+  EXPECT_EQ(run.exit, 0) << run.err;
+  EXPECT_EQ(run.out, "quad-5 AIN1.voltage_mV = 1800\n");
+  EXPECT_EQ(run.err, "canfleet: notice: AIN1.voltage_mV is deprecated: use IN1.voltage_mV\n");
 }
 
 TEST_F(CanfleetCli, HelpAndVersionExitWithZero) {
@@ -517,30 +573,30 @@ TEST_F(CanfleetCli, IoSetAndGet) {
     Response r;
     *r.mutable_io() = Parse<IoValues>(R"pb(
       node: "quad-5"
-      values { name: "AIN1.voltage_mV" value: "2500" unit: "mV" input: true }
-      values { name: "POUT1.current_mA" value: "0" unit: "mA" })pb");
+      values { name: "IN1.voltage_mV" value: "2500" unit: "mV" input: true }
+      values { name: "OUT1.current_mA" value: "0" unit: "mA" })pb");
     if (!request.io_get().name().empty()) r.mutable_io()->mutable_values()->DeleteSubrange(1, 1);
     return r;
   });
-  Outcome run = Canfleet({"io", "set", "quad-5", "AIN1.voltage_mV", "2500"});
+  Outcome run = Canfleet({"io", "set", "quad-5", "IN1.voltage_mV", "2500"});
   EXPECT_EQ(run.exit, 0) << run.err;
-  EXPECT_EQ(run.out, "quad-5 AIN1.voltage_mV = 2500\n");
+  EXPECT_EQ(run.out, "quad-5 IN1.voltage_mV = 2500\n");
   EXPECT_TRUE(Same(handler_.Requests().back().io_set(),
-                   Parse<IoSet>("node: 'quad-5' name: 'AIN1.voltage_mV' value: '2500'")));
+                   Parse<IoSet>("node: 'quad-5' name: 'IN1.voltage_mV' value: '2500'")));
 
   run = Canfleet({"io", "get", "quad-5"});
   EXPECT_EQ(run.out,
-            "SIGNAL            VALUE  UNIT  DIRECTION\n"
-            "AIN1.voltage_mV    2500  mV    input\n"
-            "POUT1.current_mA      0  mA    output\n");
-  run = Canfleet({"io", "get", "quad-5", "AIN1.voltage_mV"});
+            "SIGNAL           VALUE  UNIT  DIRECTION\n"
+            "IN1.voltage_mV    2500  mV    input\n"
+            "OUT1.current_mA      0  mA    output\n");
+  run = Canfleet({"io", "get", "quad-5", "IN1.voltage_mV"});
   EXPECT_EQ(run.out, "2500\n") << "one signal: its value alone";
   EXPECT_TRUE(
-      Same(handler_.Requests().back().io_get(), Parse<IoGet>("node: 'quad-5' name: 'AIN1.voltage_mV'")));
+      Same(handler_.Requests().back().io_get(), Parse<IoGet>("node: 'quad-5' name: 'IN1.voltage_mV'")));
   run = Canfleet({"io", "get", "quad-5", "--json"});
   IoValues parsed;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(run.out, &parsed).ok()) << run.out;
-  EXPECT_EQ(parsed.values(0).name(), "AIN1.voltage_mV");
+  EXPECT_EQ(parsed.values(0).name(), "IN1.voltage_mV");
 }
 
 TEST_F(CanfleetCli, SdoReadSendsTheAddressAndPrintsTheValue) {
@@ -556,7 +612,7 @@ TEST_F(CanfleetCli, SdoReadSendsTheAddressAndPrintsTheValue) {
   EXPECT_TRUE(Same(handler_.Requests().back().sdo_read(),
                    Parse<SdoRead>("node: 'quad-5' index: 0x1017 subindex: 0 type: 'u16'")));
 
-  run = Canfleet({"sdo", "read", "psu-1", "1018h", "0x04", "--block", "--port", "1"});
+  run = Canfleet({"sdo", "read", "psu-1", "1018h", "0x04", "--block", "--port", "CAN2"});
   EXPECT_EQ(run.out, "E8 03\n") << "without a type: the bytes in hex";
   EXPECT_TRUE(Same(handler_.Requests().back().sdo_read(),
                    Parse<SdoRead>("node: 'psu-1' index: 0x1018 subindex: 4 block: true port: 1")));
@@ -665,9 +721,9 @@ TEST_F(CanfleetCli, DumpJsonPrintsOneFramePerLine) {
   EXPECT_EQ(run.exit, 0) << run.err;
   EXPECT_EQ(
       run.out,
-      "{\"bus\":\"can0\",\"time_ns\":\"1700000000123456000\",\"id\":389,\"extended\":false,\"remote\":false,"
+      "{\"bus\":\"can0\",\"time_ns\":1700000000123456000,\"id\":389,\"extended\":false,\"remote\":false,"
       "\"error\":false,\"data\":\"AQIDAA==\"}\n"
-      "{\"bus\":\"can0\",\"time_ns\":\"1700000000124456000\",\"id\":389,\"extended\":false,\"remote\":false,"
+      "{\"bus\":\"can0\",\"time_ns\":1700000000124456000,\"id\":389,\"extended\":false,\"remote\":false,"
       "\"error\":false,\"data\":\"AQIDAQ==\"}\n");
 }
 

@@ -94,7 +94,8 @@ class DataLoggerFleetTest : public ProductFleetTest {
       ASSERT_TRUE(WaitUntil([&] { return SdoOn(port, "0x1001", 0, "u8") == 0u; }, kProductPatience))
           << "port " << port + 1 << "\n"
           << fleet().Log();
-      ASSERT_TRUE(Cli({"sdo", "write", kLogger, "0x1003", "0", "u8", "0", "--port", std::to_string(port)}));
+      ASSERT_TRUE(
+          Cli({"sdo", "write", kLogger, "0x1003", "0", "u8", "0", "--port", std::to_string(port + 1)}));
       ASSERT_EQ(SdoOn(port, "0x1003", 0, "u8"), 0u) << "port " << port + 1;
     }
   }
@@ -119,8 +120,8 @@ class DataLoggerFleetTest : public ProductFleetTest {
   /// `canfleet sdo read datalogger INDEX SUB TYPE --port PORT`: the raw value (little-endian), or
   /// nullopt when it aborted or did not answer.
   std::optional<std::uint64_t> SdoOn(int port, const std::string& index, int sub, const std::string& type) {
-    const auto result = fleet().Cli(
-        {"sdo", "read", kLogger, index, std::to_string(sub), type, "--port", std::to_string(port), "--json"});
+    const auto result = fleet().Cli({"sdo", "read", kLogger, index, std::to_string(sub), type, "--port",
+                                     std::to_string(port + 1), "--json"});
     if (result.exit_code != 0) return std::nullopt;
     control::SdoData data;
     if (!ParseJson(result.out, data)) return std::nullopt;
@@ -349,7 +350,7 @@ TEST_F(DataLoggerFleetTest, ThermocoupleOverItsWarningThresholdIsReportedOnBothP
 TEST_F(DataLoggerFleetTest, SaveOnTheSecondPortAndPowerCycleKeepTheSharedValues) {
   ASSERT_TRUE(Cli({"sdo", "write", kLogger, "0x2170", "1", "i16", "-400"}));
   ASSERT_TRUE(Cli({"sdo", "write", kLogger, "0x1801", "5", "u16", "250"}));
-  ASSERT_TRUE(Cli({"sdo", "write", kLogger, "0x1010", "1", "u32", "0x65766173", "--port", "1"}));
+  ASSERT_TRUE(Cli({"sdo", "write", kLogger, "0x1010", "1", "u32", "0x65766173", "--port", "CAN2"}));
   const auto before = fleet().Status();
   const int old_pid = fleet().Node(before, kLogger)->pid();
   ASSERT_GT(old_pid, 0);

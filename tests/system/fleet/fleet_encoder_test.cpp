@@ -29,8 +29,8 @@ constexpr const char* kTopology = R"(
 name: "fleet-test"
 bus { name: "can0" bitrate: 250000 }
 node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0"
-       io { key: "AIN1.voltage_mV" value: "1000" }
-       io { key: "AIN2.voltage_mV" value: "800" }
+       io { key: "IN1.voltage_mV" value: "1000" }
+       io { key: "IN2.voltage_mV" value: "800" }
        sdo { index: 0x1800 subindex: 1 type: "u32" value: "0x80000185" }
        sdo { index: 0x1A00 subindex: 0 type: "u8" value: "2" }
        sdo { index: 0x1800 subindex: 1 type: "u32" value: "0x185" }

@@ -72,7 +72,7 @@ class FleetFaultsTest : public ::testing::Test {
   }
   /// POUT1 of quad-6 in mA, -1 when it cannot be read.
   double Pout1() const {
-    const auto value = fleet.IoGet("quad-6", "POUT1.current_mA");
+    const auto value = fleet.IoGet("quad-6", "OUT1.current_mA");
     return value ? std::stod(*value) : -1;
   }
 
@@ -180,18 +180,34 @@ TEST_F(FleetFaultsTest, BusOffWithManualRecoveryHoldsUntilCleared) {
 }
 
 // Through the real CLI: an option bus-off does not take is refused by the orchestrator with what
-// it takes (nothing is injected); `--duration` holds the bus-off: the node's controller shows
-// bus-off with TEC > 255 for the whole time while its recovery attempts fail (ISO 11898-1:2015
-// §12.1.4.2: 1408 bit times each, 5.6 ms at 250 kbit/s, counted as the fault's hits), then it
+// it takes (nothing is injected), a bad argument (exit 2); `--duration` holds the bus-off: the node's
+// controller shows bus-off with TEC > 255 for the whole time while its recovery attempts fail (ISO
+// 11898-1:2015 §12.1.4.2: 1408 bit times each, 5.6 ms at 250 kbit/s, counted as the fault's hits), then it
 // recovers by itself.
 TEST_F(FleetFaultsTest, BusOffHeldForADurationAndOptionsThatDoNotApplyAreRefused) {
   const auto refused = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--cob-id", "0x185"});
-  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_EQ(refused.exit_code, 2);
   EXPECT_EQ(
       refused.err,
       "canfleet: --cob-id does not apply to bus-off (it takes --node, --bus, --duration, --manual-recovery, "
       "--label)\n");
   EXPECT_EQ(fleet.Node(fleet.Status(), "quad-6")->controller(), "error-active");
+  // A kind without what it needs, an unknown node, an unknown signal: bad arguments too, each
+  // with what would be valid (fault_kinds.cpp; the nearest names).
+  const auto no_cob_id = fleet.Cli({"fault", "inject", "rpdo-timeout", "--node", "quad-6"});
+  EXPECT_EQ(no_cob_id.exit_code, 2) << no_cob_id.err;
+  EXPECT_NE(no_cob_id.err.find("--cob-id"), std::string::npos) << no_cob_id.err;
+  const auto no_node = fleet.Cli({"io", "get", "quad-9"});
+  EXPECT_EQ(no_node.exit_code, 2);
+  EXPECT_EQ(
+      no_node.err,
+      "canfleet: no node called 'quad-9' in this fleet; nearest: quad-5, quad-6; all: canfleet status\n");
+  const auto no_signal = fleet.Cli({"io", "get", "quad-5", "IN9.voltage_mV"});
+  EXPECT_EQ(no_signal.exit_code, 2);
+  EXPECT_EQ(no_signal.err,
+            "canfleet: no signal IN9.voltage_mV on quad-5; nearest: IN1.voltage_mV, IN2.voltage_mV, "
+            "IN3.voltage_mV; "
+            "all: canfleet io get quad-5\n");
 
   const auto injected = fleet.Cli({"fault", "inject", "bus-off", "--node", "quad-6", "--duration", "2s"});
   ASSERT_EQ(injected.exit_code, 0) << injected.err;

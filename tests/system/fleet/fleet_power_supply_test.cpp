@@ -31,7 +31,7 @@ constexpr const char* kTopology = R"(
 name: "fleet-test"
 bus { name: "can0" bitrate: 250000 }
 node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0"
-       io { key: "AIN1.voltage_mV" value: "253" }
+       io { key: "IN1.voltage_mV" value: "253" }
        sdo { index: 0x1800 subindex: 1 type: "u32" value: "0x80000185" }
        sdo { index: 0x1A00 subindex: 0 type: "u8" value: "1" }
        sdo { index: 0x1800 subindex: 1 type: "u32" value: "0x185" }
@@ -51,7 +51,7 @@ class FleetPowerSupplyTest : public ProductFleetTest {
     // The ON command by PDO switches the output on: 24 V (6205h.1) into the default 24 ohm load.
     ASSERT_TRUE(WaitUntil([&] { return IoText("psu", "PS.output_on") == "true"; }, kProductPatience))
         << IoText("psu", "PS.state");
-    ASSERT_TRUE(WaitIo("psu", "VOUT.voltage_V", 24)) << IoText("psu", "VOUT.voltage_V");
+    ASSERT_TRUE(WaitIo("psu", "VOUT.voltage_mV", 24000)) << IoText("psu", "VOUT.voltage_mV");
   }
 
   /// README choice 15: the output stays on and regulating after the fault.
@@ -59,10 +59,10 @@ class FleetPowerSupplyTest : public ProductFleetTest {
     EXPECT_TRUE(HoldsFor(
         [&] {
           return IoText("psu", "PS.output_on") == "true" && IoText("psu", "PS.state") == "on" &&
-                 Reads("psu", "VOUT.voltage_V", 24);
+                 Reads("psu", "VOUT.voltage_mV", 24000);
         },
         kNoChangeWindow, kNoChangeReason))
-        << IoText("psu", "PS.state") << ", " << IoText("psu", "VOUT.voltage_V");
+        << IoText("psu", "PS.state") << ", " << IoText("psu", "VOUT.voltage_mV");
   }
 };
 
@@ -152,7 +152,7 @@ TEST_F(FleetPowerSupplySequenceTest, OnByCanCurrentLimitLatchedFailuresQuitFailu
   // §2.3.16: 6200h.2 = FDh switches the output on (6010h.1 = FFh: the latest command, Table 1).
   ASSERT_TRUE(Write("0x6200", 2, "u8", "0xFD"));
   ASSERT_TRUE(WaitState("on"));
-  EXPECT_TRUE(WaitIo("psu", "IOUT.current_A", 6)) << IoText("psu", "IOUT.current_A");  // 24 V / 4 ohm
+  EXPECT_TRUE(WaitIo("psu", "IOUT.current_mA", 6000)) << IoText("psu", "IOUT.current_mA");  // 24 V / 4 ohm
 
   // §1.2.1.3 Fig. 2 (README choice 8): 15 A at and above 18 V input; 1 ohm wants 24 A and gets 15 A
   // at 15 V. The output current threshold 2 moved above it first (6205h.12/.42), so no failure.
@@ -160,8 +160,8 @@ TEST_F(FleetPowerSupplySequenceTest, OnByCanCurrentLimitLatchedFailuresQuitFailu
   ASSERT_TRUE(Write("0x6205", 42, "i32", "20000"));
   ASSERT_TRUE(Set("LOAD.resistance_ohm", "1"));
   EXPECT_TRUE(WaitUntil([&] { return IoText("psu", "PS.current_limited") == "true"; }, kProductPatience));
-  EXPECT_TRUE(WaitIo("psu", "IOUT.current_A", 15)) << IoText("psu", "IOUT.current_A");
-  EXPECT_TRUE(WaitIo("psu", "VOUT.voltage_V", 15)) << IoText("psu", "VOUT.voltage_V");
+  EXPECT_TRUE(WaitIo("psu", "IOUT.current_mA", 15000)) << IoText("psu", "IOUT.current_mA");
+  EXPECT_TRUE(WaitIo("psu", "VOUT.voltage_mV", 15000)) << IoText("psu", "VOUT.voltage_mV");
   EXPECT_FALSE(LastEmcyOf("psu").has_value());
 
   // Back to the manual's 13 A: above it for 6205h.14 + 6013h.2, the output failure FF06h (Table 9);
@@ -180,7 +180,7 @@ TEST_F(FleetPowerSupplySequenceTest, OnByCanCurrentLimitLatchedFailuresQuitFailu
   // §1.2.3: the input below 6114h (9 V) is an input failure: EMCY FF04h, 1003h 0000FF04h, 1001h bit
   // 0; 6112h Vt1 (bits 1-0): condition 00 (below its return), event and indication 01 (§2.3.9);
   // 6012h "i" (bits 1-0) 01 (§2.3.2); the output off and latched.
-  ASSERT_TRUE(Set("VIN.voltage_V", "8"));
+  ASSERT_TRUE(Set("VIN.voltage_mV", "8000"));
   EXPECT_TRUE(WaitLog(EmcyLine("psu", 0xFF04, 0x01, "00 00 00 00 00"))) << fleet().Log();
   EXPECT_TRUE(WaitState("fault_latched"));
   EXPECT_EQ(Sdo("psu", "0x1003", 1, "u32"), 0x0000FF04u);
@@ -190,7 +190,7 @@ TEST_F(FleetPowerSupplySequenceTest, OnByCanCurrentLimitLatchedFailuresQuitFailu
   EXPECT_EQ(Sdo("psu", "0x6112", 5, "u32").value_or(0) & 0x3, 0x1u);
   EXPECT_EQ(Sdo("psu", "0x6012", 1, "u32").value_or(0) & 0x3, 0x1u);
   // The input recovers: the failure ends (EMCY 0000h, 1001h = 0), the latch stays until Quit Failure.
-  ASSERT_TRUE(Set("VIN.voltage_V", "24"));
+  ASSERT_TRUE(Set("VIN.voltage_mV", "24000"));
   EXPECT_TRUE(WaitUntil([&] { return LastEmcyOf("psu") == 0x0000u; }, kProductPatience));
   EXPECT_EQ(Sdo("psu", "0x1001", 0, "u8"), 0u);
   EXPECT_EQ(IoText("psu", "PS.state"), "fault_latched");

@@ -246,8 +246,8 @@ node { name: "remote-8" device: "quad-controller" node_id: 8 bus: "can0" externa
   ASSERT_TRUE(fleet.WaitReady()) << fleet.Log();
   EXPECT_TRUE(WaitAttachedAndOperational(fleet, "remote-8")) << fleet.Log();
   EXPECT_EQ(fleet.SdoReadUnsigned("remote-8", "0x1017", 0, "u16"), 300u);  // configured by the orchestrator
-  ASSERT_EQ(fleet.Cli({"io", "set", "remote-8", "AIN1.voltage_mV", "2500"}).exit_code, 0);
-  EXPECT_EQ(fleet.IoGet("remote-8", "AIN1.voltage_mV"), "2500");
+  ASSERT_EQ(fleet.Cli({"io", "set", "remote-8", "IN1.voltage_mV", "2500"}).exit_code, 0);
+  EXPECT_EQ(fleet.IoGet("remote-8", "IN1.voltage_mV"), "2500");
   // Its process is not ours to kill.
   EXPECT_EQ(fleet.Cli({"fault", "inject", "kill", "--node", "remote-8"}).exit_code, 1);
 }

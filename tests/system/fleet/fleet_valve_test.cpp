@@ -28,7 +28,7 @@ constexpr const char* kTopology = R"(
 name: "fleet-test"
 bus { name: "can0" bitrate: 250000 }
 node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0"
-       io { key: "AIN1.voltage_mV" value: "1000" }
+       io { key: "IN1.voltage_mV" value: "1000" }
        heartbeat { producer_ms: 200 } }
 node { name: "valve-a" device: "valve-12in12out" node_id: 32 bus: "can0"
        heartbeat { producer_ms: 200 consumer { node: "quad-5" timeout_ms: 1000 } }

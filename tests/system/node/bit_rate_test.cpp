@@ -169,7 +169,7 @@ TEST_F(CanfleetNodeBitRate, LssActivateBitTimingCutsANodeOffAndSwitchingItBackRe
   SelectB();
   const std::size_t switched = master.Frames().size();
   SwitchSelectedTo(3);  // 250 kbit/s
-  EXPECT_TRUE(master.RunUntil([&] { return AnyLine(*b, "port 1: bit rate now 250 kbit/s"); })) << b->Output();
+  EXPECT_TRUE(master.RunUntil([&] { return AnyLine(*b, "CAN1: bit rate now 250 kbit/s"); })) << b->Output();
   ExpectBCutOff(switched, true);
   // At the bus's rate the master cannot reach B: its LSS request goes unanswered.
   std::size_t from = master.Frames().size();
@@ -185,7 +185,7 @@ TEST_F(CanfleetNodeBitRate, LssActivateBitTimingCutsANodeOffAndSwitchingItBackRe
   MasterAt(0);
   ExpectBBack(from, true);
   SendLss(0x04, {0});  // switch state global: waiting
-  EXPECT_TRUE(AnyLine(*b, "port 1: bit rate now 500 kbit/s")) << b->Output();
+  EXPECT_TRUE(AnyLine(*b, "CAN1: bit rate now 500 kbit/s")) << b->Output();
   EXPECT_TRUE(a->process().Running()) << a->Output();
   EXPECT_TRUE(b->process().Running()) << b->Output();
 }
@@ -197,7 +197,7 @@ TEST_F(CanfleetNodeBitRate, AStored5B50hTakesEffectAtResetAndSurvivesAPowerCycle
   ASSERT_EQ(master.Write(kB, 0x1010, 1, 0x65766173, 4), SdoAbort::kNone);  // "save" all
   const std::size_t reset = master.Frames().size();
   ASSERT_TRUE(master.Nmt(BusMaster::kNmtResetNode, kB));
-  EXPECT_TRUE(master.RunUntil([&] { return AnyLine(*b, "port 1: bit rate now 250 kbit/s"); })) << b->Output();
+  EXPECT_TRUE(master.RunUntil([&] { return AnyLine(*b, "CAN1: bit rate now 250 kbit/s"); })) << b->Output();
   ExpectBCutOff(reset, false);  // reset: B's consumer waits for a first heartbeat of A
 
   // Power cycle: B comes back at its stored 250 kbit/s (its boot-up is destroyed, not received).

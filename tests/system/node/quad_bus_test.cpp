@@ -71,8 +71,8 @@ TEST(CanfleetNodeQuadBus, AnInputOfNode5MovesAnOutputOfNode6AcrossTheBus) {
   EXPECT_EQ(master.ReadUnsigned(6, 0x1600, 2), 0x00030010u);
 
   // The first input value, set on node 5's pins (its simulated AIN1).
-  EXPECT_EQ(node5.Set("AIN1.voltage_mV", "1200"), "ok");
-  EXPECT_EQ(node6.GetNumber("POUT1.current_mA"), 0.0);  // §4.2: pre-operational, no PDOs yet
+  EXPECT_EQ(node5.Set("IN1.voltage_mV", "1200"), "ok");
+  EXPECT_EQ(node6.GetNumber("OUT1.current_mA"), 0.0);  // §4.2: pre-operational, no PDOs yet
 
   // CiA 301 §7.2.8.3.1: NMT start, all nodes. PDOs run in operational only.
   ASSERT_TRUE(master.Nmt(BusMaster::kNmtStart, 0));
@@ -82,24 +82,24 @@ TEST(CanfleetNodeQuadBus, AnInputOfNode5MovesAnOutputOfNode6AcrossTheBus) {
   ASSERT_TRUE(master.WaitForFrame([](const SeenFrame& f) { return f.text.starts_with("185#B004"); }, started))
       << node5.Output();
   // Node 6's POUT1 follows: 1200 mA (§3.5.20 field value in mA; 30A0h = 2: no ramp under CAN).
-  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("POUT1.current_mA") == 1200.0; }))
-      << "POUT1 of node 6: " << node6.Get("POUT1.current_mA").value_or("?") << "\n"
+  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("OUT1.current_mA") == 1200.0; }))
+      << "POUT1 of node 6: " << node6.Get("OUT1.current_mA").value_or("?") << "\n"
       << node6.Output();
   // ... and says so on the bus: TPDO4 (480h + 6) maps 30C0h.1, the measured current (§3.5.12).
   EXPECT_TRUE(
       master.WaitForFrame([](const SeenFrame& f) { return f.text.starts_with("486#B004"); }, started));
 
   // The input moves again, the output follows again.
-  EXPECT_EQ(node5.Set("AIN1.voltage_mV", "1800"), "ok");
-  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("POUT1.current_mA") == 1800.0; }))
-      << "POUT1 of node 6: " << node6.Get("POUT1.current_mA").value_or("?") << "\n"
+  EXPECT_EQ(node5.Set("IN1.voltage_mV", "1800"), "ok");
+  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("OUT1.current_mA") == 1800.0; }))
+      << "POUT1 of node 6: " << node6.Get("OUT1.current_mA").value_or("?") << "\n"
       << node6.Output();
   EXPECT_EQ(master.ReadUnsigned(6, 0x7330, 1), 1800u);  // what the RPDO wrote
   EXPECT_EQ(master.ReadUnsigned(6, 0x30C0, 1), 1800u);  // what flows
 
   // §4.2 again: back in pre-operational, the CAN-controlled output of node 6 switches off.
   ASSERT_TRUE(master.Nmt(BusMaster::kNmtPreOperational, 6));
-  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("POUT1.current_mA") == 0.0; })) << node6.Output();
+  EXPECT_TRUE(master.RunUntil([&] { return node6.GetNumber("OUT1.current_mA") == 0.0; })) << node6.Output();
 
   // Nothing went wrong on the way (§4.1: no EMCY from either node).
   for (const auto& f : master.Frames())

@@ -28,8 +28,8 @@ class CanfleetNodeQuadConformance : public ::testing::Test {
     std::vector<std::string> args = {"--device",  "quad-controller",
                                      "--node-id", std::to_string(kNodeId),
                                      "--bus",     "can0@" + broker_.endpoint()};
-    for (const char* input : {"AIN1.voltage_mV=0", "AIN2.voltage_mV=0", "AIN3.voltage_mV=0",
-                              "AIN4.voltage_mV=0", "FIN1.duty_pct=0", "FIN2.duty_pct=0"}) {
+    for (const char* input : {"IN1.voltage_mV=0", "IN2.voltage_mV=0", "IN3.voltage_mV=0", "IN4.voltage_mV=0",
+                              "IN5.duty_pct=0", "IN6.duty_pct=0"}) {
       args.push_back("--io");
       args.push_back(input);
     }

@@ -28,7 +28,7 @@ std::string Topology() {
   return R"(name: "verdicts"
 bus { name: "can0" bitrate: 250000 }
 node { name: "quad-5" device: "quad-controller" node_id: 5 bus: "can0"
-       io { key: "AIN1.voltage_mV" value: "1200" }
+       io { key: "IN1.voltage_mV" value: "1200" }
        heartbeat { producer_ms: 200 } }
 node { name: "quad-6" device: "quad-controller" node_id: 6 bus: "can0"
        heartbeat { producer_ms: 200 consumer { node: "quad-5" timeout_ms: 1000 } }
@@ -37,7 +37,7 @@ node { name: "quad-6" device: "quad-controller" node_id: 6 bus: "can0"
 scenario_repeat_ms: 600000
 scenario { name: "steady" expect { within_ms: 3000 nmt { node: "quad-6" state: "operational" } } }
 scenario { name: "wrong-current" expect { within_ms: 1500 throughout: true
-  io { node: "quad-6" name: "POUT1.current_mA" min: 4000 max: 5000 } } }
+  io { node: "quad-6" name: "OUT1.current_mA" min: 4000 max: 5000 } } }
 )";
 }
 

@@ -3,7 +3,7 @@
 // tools use (FleetView), sees
 //  - both nodes with their NMT state (the same the node answers to `nmt` on its stdin), booted
 //    into pre-operational, then operational after an NMT start from the master's port,
-//  - an input change in a node's IoSnapshot (`set AIN1.voltage_mV 3300` on its stdin),
+//  - an input change in a node's IoSnapshot (`set IN1.voltage_mV 3300` on its stdin),
 //  - the EMCY of a load fault (Quad §4.1: a short on DOUT is FF02h after the 300Bh delay, 1 s) and
 //    1001h in the node's status, then the error reset when the load is repaired,
 //  - the BusStats of the broker's bus (its two ports, frames counted),
@@ -188,16 +188,16 @@ TEST_F(NodeTelemetryProcesses, BrokerAndTwoQuadNodesPublishStatusIoEmcyBusStatsA
 
   // The simulated I/O: an input set on node 5's stdin reaches its IoSnapshot.
   ASSERT_TRUE(monitor.Until([&] {
-    return monitor.Input(5, "AIN1.voltage_mV") == 2500.0 && monitor.Input(6, "AIN1.voltage_mV") == 2500.0;
+    return monitor.Input(5, "IN1.voltage_mV") == 2500.0 && monitor.Input(6, "IN1.voltage_mV") == 2500.0;
   })) << monitor.Describe();
-  Command(*node5, "set AIN1.voltage_mV 3300");
-  ASSERT_TRUE(monitor.Until([&] { return monitor.Input(5, "AIN1.voltage_mV") == 3300.0; }))
+  Command(*node5, "set IN1.voltage_mV 3300");
+  ASSERT_TRUE(monitor.Until([&] { return monitor.Input(5, "IN1.voltage_mV") == 3300.0; }))
       << monitor.Describe();
-  EXPECT_EQ(monitor.Input(6, "AIN1.voltage_mV"), 2500.0);
+  EXPECT_EQ(monitor.Input(6, "IN1.voltage_mV"), 2500.0);
 
   // A load fault on node 6 (Quad §4.1): DOUT shorted → EMCY FF02h, 1001h bit 0, channel 05h,
   // description 02h in the manufacturer bytes.
-  Command(*node6, "set DOUT.load short");
+  Command(*node6, "set OUT5.load short");
   ASSERT_TRUE(monitor.Until([&] {
     const auto& status = monitor.Node(6)->status;
     return monitor.Emcy(6, 0xFF02) != nullptr && status.last_emcy && status.last_emcy->code == 0xFF02;
@@ -208,7 +208,7 @@ TEST_F(NodeTelemetryProcesses, BrokerAndTwoQuadNodesPublishStatusIoEmcyBusStatsA
   EXPECT_EQ(emcy.manufacturer, (std::array<std::uint8_t, 5>{0x05, 0x02, 0x00, 0x00, 0x00}));
   EXPECT_EQ(monitor.Emcy(5, 0xFF02), nullptr);
   // Repaired: the error reset EMCY (0000h) and 1001h back to 0.
-  Command(*node6, "set DOUT.load nominal");
+  Command(*node6, "set OUT5.load nominal");
   ASSERT_TRUE(monitor.Until([&] {
     return monitor.Emcy(6, 0x0000) != nullptr && monitor.Node(6)->status.error_register == 0;
   })) << monitor.Describe();

@@ -24,8 +24,8 @@ class AiTest : public DataLoggerTest {
 // §3.2.15: TPDO1-3 carry 7100h sub 1-10 every 100 ms in Operational (node 5: 185h, 285h, 385h);
 // §1.4/§4: the default 0-5 V inputs read 2.500 V as 2500 [mV].
 TEST_F(AiTest, DefaultTpdosCarryTheFieldValues) {
-  SetNumber("AIN2.voltage_mV", 1234);
-  SetNumber("AIN10.voltage_mV", 4321);
+  SetNumber("IN2.voltage_mV", 1234);
+  SetNumber("IN10.voltage_mV", 4321);
   Start(0);
   Advance(100ms);
   const auto frames = Frames(0);
@@ -37,7 +37,7 @@ TEST_F(AiTest, DefaultTpdosCarryTheFieldValues) {
 
 // §1.4 "New measured values are ready every 10 ms": a change shows on the next 10 ms scan.
 TEST_F(AiTest, ValuesFollowTheNextScan) {
-  SetNumber("AIN1.voltage_mV", 3000);
+  SetNumber("IN1.voltage_mV", 3000);
   EXPECT_EQ(Fv(1), 2500);
   Advance(10ms);
   EXPECT_EQ(Fv(1), 3000);
@@ -48,7 +48,7 @@ TEST_F(AiTest, ValuesFollowTheNextScan) {
 TEST_F(AiTest, ProcessValueScaling) {
   Write(0, kAiScaling1Pv, 3, 0, 2);
   Write(0, kAiScaling2Pv, 3, 1000, 2);  // 0.5 V -> 0, 4.5 V -> 1000
-  SetNumber("AIN3.voltage_mV", 2500);
+  SetNumber("IN3.voltage_mV", 2500);
   Advance(10ms);
   EXPECT_EQ(Read(0, kAiProcessValue, 3, true), 500);
 }
@@ -59,7 +59,7 @@ TEST_F(AiTest, MovingAverageFilter) {
   Write(0, kAiFilterConstant, 1, 10, 2);
   Advance(500ms);  // settled on 2500
   ASSERT_EQ(Fv(1), 2500);
-  SetNumber("AIN1.voltage_mV", 4000);
+  SetNumber("IN1.voltage_mV", 4000);
   Advance(10ms);
   // 10 calls: 4000 - 1500 x 0.9^10 = 3477.0
   EXPECT_NEAR(static_cast<double>(Fv(1)), 3477.0, 1.0);
@@ -74,7 +74,7 @@ TEST_F(AiTest, SpanFaultAfterTheReactionDelayOnBothPorts) {
   Write(1, 0x1029, 3, 0, 1);  // CAN2: input faults -> pre-operational
   StartBoth();
   SilenceTpdos();
-  SetNumber("AIN1.voltage_mV", 4900);  // > 4800
+  SetNumber("IN1.voltage_mV", 4900);  // > 4800
   Advance(990ms);
   EXPECT_TRUE(Frames(0, "085#").empty());
   Advance(20ms);
@@ -84,10 +84,10 @@ TEST_F(AiTest, SpanFaultAfterTheReactionDelayOnBothPorts) {
   EXPECT_EQ(stack(0).State(), canopen::NmtState::kOperational);
   EXPECT_EQ(stack(1).State(), canopen::NmtState::kPreOperational);
 
-  SetNumber("AIN1.voltage_mV", 4750);  // above 4800 - 100: still out of range
+  SetNumber("IN1.voltage_mV", 4750);  // above 4800 - 100: still out of range
   Advance(20ms);
   EXPECT_TRUE(Frames(0, "085#").empty());
-  SetNumber("AIN1.voltage_mV", 4700);
+  SetNumber("IN1.voltage_mV", 4700);
   Advance(20ms);
   EXPECT_EQ(Frames(0, "085#"), std::vector<std::string>{EmcyReset(kNode1, 0)});
   EXPECT_TRUE(ErrorField(0).empty());
@@ -100,7 +100,7 @@ TEST_F(AiTest, LowFaultOnAUniversalInputTakesNoReaction) {
   Write(0, kAiErrorDelay, 9, 0, 2);
   Write(0, 0x1029, 3, 2, 1);
   Start(0);
-  SetNumber("AIN9.voltage_mV", 100);  // < 200
+  SetNumber("IN9.voltage_mV", 100);  // < 200
   Advance(10ms);
   EXPECT_EQ(Frames(0, "085#"), std::vector<std::string>{Emcy(kNode1, 0xF001, 0x01, 0x09, 0x40)});
   EXPECT_EQ(stack(0).State(), canopen::NmtState::kOperational);
@@ -119,7 +119,7 @@ TEST_F(AiTest, AutomaticUpdatesFollowTable11) {
   Write(1, kAiRange, 2, 1, 1);  // 4-20 mA, written on CAN2: the same shared objects
   EXPECT_EQ(Read(0, kAiSpanStart, 2, true), 3);
   EXPECT_EQ(Read(0, kAiScaling1Fv, 2, true), 4);
-  SetNumber("AIN2.current_uA", 12000);
+  SetNumber("IN2.current_mA", 12);
   Advance(10ms);
   EXPECT_EQ(Fv(2), 12);
   // Writing the type that is already there (a DCF download) changes nothing (README B18).
@@ -191,20 +191,20 @@ TEST_F(AiTest, DigitalInputModes) {
   Write(0, kDiPolarity, 8, 1, 1);  // inverse
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 0);
-  SetEnum("DIN8.level", "low");
+  SetEnum("IN8.level", "low");
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 1);
 
   Write(0, kDiPolarity, 8, 2, 1);  // latched
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 0);
-  SetEnum("DIN8.level", "high");
+  SetEnum("IN8.level", "high");
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 1);
-  SetEnum("DIN8.level", "low");  // HIGH -> LOW: no change
+  SetEnum("IN8.level", "low");  // HIGH -> LOW: no change
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 1);
-  SetEnum("DIN8.level", "high");
+  SetEnum("IN8.level", "high");
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 8), 0);
   // Other modes: 6020h is 0 (§1.3 "For all other operating modes, object 6020h will always be
@@ -215,14 +215,14 @@ TEST_F(AiTest, DigitalInputModes) {
 // §1.3 Figure 5 (damaged): analog on/off (any input) turns ON at 7122h and OFF at 7120h.
 TEST_F(AiTest, AnalogOnOffHysteresis) {
   Write(0, kAiOperatingMode, 2, kModeAnalogOnOff, 1);
-  SetNumber("AIN2.voltage_mV", 4600);
+  SetNumber("IN2.voltage_mV", 4600);
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 2), 1);
-  SetNumber("AIN2.voltage_mV", 2000);  // between MIN 500 and MAX 4500: holds
+  SetNumber("IN2.voltage_mV", 2000);  // between MIN 500 and MAX 4500: holds
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 2), 1);
   EXPECT_EQ(Fv(2), 2000);  // the analog chain still runs
-  SetNumber("AIN2.voltage_mV", 400);
+  SetNumber("IN2.voltage_mV", 400);
   Advance(10ms);
   EXPECT_EQ(Read(0, kDiState, 2), 0);
 }
@@ -231,7 +231,7 @@ TEST_F(AiTest, AnalogOnOffHysteresis) {
 // row, 0.1 rpm); PWM on input 9 in 0.1 %.
 TEST_F(AiTest, FrequencyRpmAndPwm) {
   Write(0, kSensorType, 8, kSensorFrequency, 2);
-  SetNumber("AIN8.frequency_Hz", 1500);
+  SetNumber("IN8.frequency_Hz", 1500);
   Advance(10ms);
   EXPECT_EQ(Fv(8), 1500);
   Write(0, kAiPulsesPerRev, 8, 60, 2);
@@ -240,7 +240,7 @@ TEST_F(AiTest, FrequencyRpmAndPwm) {
   Advance(10ms);
   EXPECT_EQ(Fv(8), 15000);  // 1500 Hz x 60 / 60 = 1500.0 rpm
   Write(0, kSensorType, 9, kSensorPwm, 2);
-  SetNumber("AIN9.duty_pct", 42.5);
+  SetNumber("IN9.duty_pct", 42.5);
   Advance(10ms);
   EXPECT_EQ(Fv(9), 425);
 }

@@ -27,27 +27,27 @@ class DiagTest : public DataLoggerTest {
 TEST_F(DiagTest, SupplyOverAndUnderVoltage) {
   Advance(10ms);
   EXPECT_FLOAT_EQ(Real32(0, kSupplyValue), 24.0f);
-  SetNumber("VPS.voltage_V", 36);
+  SetNumber("VPS.voltage_mV", 36000);
   Advance(10ms);
   EXPECT_EQ(Frames(0, "085#"), std::vector<std::string>{Emcy(kNode1, 0x3000, 0x01, 0x00, 0x20)});
-  SetNumber("VPS.voltage_V", 31);
+  SetNumber("VPS.voltage_mV", 31000);
   Advance(10ms);
   EXPECT_EQ(ErrorField(0), std::vector<std::uint32_t>{0x20003000});
-  SetNumber("VPS.voltage_V", 30);
+  SetNumber("VPS.voltage_mV", 30000);
   Advance(10ms);
   EXPECT_TRUE(ErrorField(0).empty());
-  SetNumber("VPS.voltage_V", 7.5);
+  SetNumber("VPS.voltage_mV", 7500);
   Advance(10ms);
   EXPECT_EQ(ErrorField(1), std::vector<std::uint32_t>{0x40003000});
-  SetNumber("VPS.voltage_V", 12);
+  SetNumber("VPS.voltage_mV", 12000);
   Advance(10ms);
   EXPECT_EQ(ErrorField(1), std::vector<std::uint32_t>{0x40003000});  // 12 < 8 + 5
-  SetNumber("VPS.voltage_V", 13);
+  SetNumber("VPS.voltage_mV", 13000);
   Advance(10ms);
   EXPECT_TRUE(ErrorField(1).empty());
   // §3.4.69: 5021h FALSE ignores the thresholds.
   Write(0, kSupplyErrorEnable, 0, 0, 1);
-  SetNumber("VPS.voltage_V", 48);  // a 48 V system: above the highest settable 5023h (36 V)
+  SetNumber("VPS.voltage_mV", 48000);  // a 48 V system: above the highest settable 5023h (36 V)
   Advance(10ms);
   EXPECT_TRUE(ErrorField(0).empty());
 }
@@ -80,11 +80,11 @@ TEST_F(DiagTest, ProcessorOverTemperature) {
 TEST_F(DiagTest, ErrorFieldKeepsFourAndClearsOnWrite) {
   Write(0, kAiErrorEnable, 1, 1, 1);
   Write(0, kAiErrorDelay, 1, 0, 2);
-  SetNumber("VPS.voltage_V", 40);
+  SetNumber("VPS.voltage_mV", 40000);
   SetNumber("TEMP.temperature_C", 90);
   SetBool("TC1.open", true);
   SetBool("TC2.open", true);
-  SetNumber("AIN1.voltage_mV", 0);
+  SetNumber("IN1.voltage_mV", 0);
   Advance(400ms);
   EXPECT_EQ(ErrorField(0).size(), 4u);
   // No 5th entry (README C8): a read past the count answers "no data available".

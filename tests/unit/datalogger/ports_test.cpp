@@ -40,7 +40,7 @@ TEST_F(PortsTest, OnePortStoppedWhileTheOtherTransmits) {
   Send(0, "000#0205");  // stop node 5 on CAN1
   EXPECT_EQ(stack(0).State(), NmtState::kStopped);
   EXPECT_EQ(stack(1).State(), NmtState::kOperational);
-  SetNumber("AIN1.voltage_mV", 3000);
+  SetNumber("IN1.voltage_mV", 3000);
   Advance(300ms);
   EXPECT_TRUE(Frames(0).empty());
   const auto tpdo1 = Frames(1, "186#");
@@ -95,8 +95,8 @@ TEST_F(DataLoggerStorageTest, RestoreOnPortOneCoversBothPorts) {
 // A stopped port sends no EMCY (CiA 301 §7.3.2.2) but records the fault in its 1003h/1001h.
 TEST_F(PortsTest, DeviceFaultOnBothPorts) {
   SilenceTpdos();
-  Send(1, "000#0206");             // CAN2 stopped
-  SetNumber("VPS.voltage_V", 40);  // > 5023h = 35 V
+  Send(1, "000#0206");                 // CAN2 stopped
+  SetNumber("VPS.voltage_mV", 40000);  // > 5023h = 35 V
   Advance(10ms);
   EXPECT_EQ(Frames(0, "085#"), std::vector<std::string>{Emcy(kNode1, 0x3000, 0x01, 0x00, 0x20)});
   EXPECT_TRUE(Frames(1).empty());
@@ -182,7 +182,7 @@ TEST_F(PortsTest, NoWakeUpsWhileSteady) {
   Advance(10s);
   EXPECT_EQ(scheduler_.FiredCount(), fired);
   EXPECT_EQ(logger().Cycles(), cycles);
-  SetNumber("AIN4.voltage_mV", 1000);
+  SetNumber("IN4.voltage_mV", 1000);
   Advance(10s);
   EXPECT_EQ(logger().Cycles(), cycles + 1);
   SetNumber("TC1.temperature_C", 30);

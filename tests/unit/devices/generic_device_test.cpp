@@ -144,8 +144,8 @@ TEST(DeviceCatalogTest, AnEntryGivesSignalsDictionaryAndPortsWithoutADevice) {
   const DeviceInfo* quad = FindDevice("quad-controller");
   ASSERT_NE(quad, nullptr);
   const auto signals = SignalsOf(*quad);
-  ASSERT_NE(signals->Find("AIN1.voltage_mV"), nullptr);
-  EXPECT_EQ(signals->Find("POUT1.current_mA")->direction(), IoDirection::kOutput);
+  ASSERT_NE(signals->Find("IN1.voltage_mV"), nullptr);
+  EXPECT_EQ(signals->Find("OUT1.current_mA")->direction(), IoDirection::kOutput);
   const canopen::ObjectDictionary od = VariantDictionary(*quad);
   EXPECT_EQ(od.GetUnsigned(0x1018, 2), 0xAA020502u);  // AX020506 §3.1, 1018h sub 2
   EXPECT_EQ(MakeDevice({"quad-controller", {}})->PortCount(), quad->ports);

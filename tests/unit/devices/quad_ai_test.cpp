@@ -11,12 +11,12 @@ class QuadAiTest : public QuadTest {};
 // appear in TPDO1 (AIN1-4 in mV) and TPDO2 (FIN1-2 duty × 100) at the 100 ms event timer.
 TEST_F(QuadAiTest, TpdosCarryTheFieldValuesOfTheSimulatedInputs) {
   Start();
-  SetNumber("AIN1.voltage_mV", 1000);
-  SetNumber("AIN2.voltage_mV", 2000);
-  SetNumber("AIN3.voltage_mV", 3000);
-  SetNumber("AIN4.voltage_mV", 4000);
-  SetNumber("FIN1.duty_pct", 12.34);
-  SetNumber("FIN2.duty_pct", 99.99);
+  SetNumber("IN1.voltage_mV", 1000);
+  SetNumber("IN2.voltage_mV", 2000);
+  SetNumber("IN3.voltage_mV", 3000);
+  SetNumber("IN4.voltage_mV", 4000);
+  SetNumber("IN5.duty_pct", 12.34);
+  SetNumber("IN6.duty_pct", 99.99);
   Advance(99ms);  // t = 100 ms since the NMT start
   EXPECT_EQ(Frames(), (std::vector<std::string>{"185#E803D007B80BA00F", "285#D2040F27", "385#0000",
                                                 "485#0000000000000000"}));
@@ -29,7 +29,7 @@ TEST_F(QuadAiTest, InputsAreSampledEveryTenMilliseconds) {
   Advance(10ms);  // t = 10 ms: sampled 2500 mV
   EXPECT_EQ(Read(0x7100, 1), 2500);
   Advance(1ms);
-  SetNumber("AIN1.voltage_mV", 1234);
+  SetNumber("IN1.voltage_mV", 1234);
   Advance(8ms);  // t = 19 ms
   EXPECT_EQ(Read(0x7100, 1), 2500);
   Advance(1ms);  // t = 20 ms
@@ -40,10 +40,10 @@ TEST_F(QuadAiTest, InputsAreSampledEveryTenMilliseconds) {
 // §3.3.13: 40 = 0-5000 mV, 42 = 0-10000 mV, 51/52 = current in µA; readings beyond the range
 // read full scale.
 TEST_F(QuadAiTest, SensorTypesSelectQuantityUnitAndRange) {
-  SetNumber("AIN1.voltage_mV", 7000);
-  SetNumber("AIN2.voltage_mV", 7000);
-  SetNumber("AIN3.current_uA", 12345);
-  SetNumber("AIN4.current_uA", 25000);
+  SetNumber("IN1.voltage_mV", 7000);
+  SetNumber("IN2.voltage_mV", 7000);
+  SetNumber("IN3.current_mA", 12.345);
+  SetNumber("IN4.current_mA", 25);
   Write(0x6110, 2, 42, 2);
   Write(0x6110, 3, 51, 2);
   Write(0x6110, 4, 52, 2);
@@ -57,9 +57,9 @@ TEST_F(QuadAiTest, SensorTypesSelectQuantityUnitAndRange) {
 // §2.4, §3.3.9: PWM duty as % × 100; frequency counted over the 2090h window and held until the
 // next window ends; a short window has a coarse resolution.
 TEST_F(QuadAiTest, PulseInputsMeasureDutyAndFrequencyOverTheWindow) {
-  SetNumber("FIN1.duty_pct", 37.5);
+  SetNumber("IN5.duty_pct", 37.5);
   Write(0x6110, 6, 60, 2);
-  SetNumber("FIN2.frequency_Hz", 1234);
+  SetNumber("IN6.frequency_Hz", 1234);
   Advance(10ms);
   EXPECT_EQ(Read(0x7100, 5), 3750);
   EXPECT_EQ(Read(0x7100, 6), 0);  // the first 1000 ms window has not ended
@@ -72,7 +72,7 @@ TEST_F(QuadAiTest, PulseInputsMeasureDutyAndFrequencyOverTheWindow) {
 
 // §2.3 / DS-404 scaling: PV = PV1 + (FV − FV1)(PV2 − PV1)/(FV2 − FV1) + offset 7124h.
 TEST_F(QuadAiTest, ScalingAndOffsetMakeTheProcessValue) {
-  SetNumber("AIN1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Write(0x7120, 1, 500, 2);   // FV1 0.5 V
   Write(0x7121, 1, 0, 2);     // PV1 0 bar
   Write(0x7122, 1, 4500, 2);  // FV2 4.5 V
@@ -88,13 +88,13 @@ TEST_F(QuadAiTest, ScalingAndOffsetMakeTheProcessValue) {
 
 // §3.3.20: "zero" to 6125h sets 7124h so that 7130h becomes 0; any other value is refused.
 TEST_F(QuadAiTest, AutozeroMakesTheProcessValueZero) {
-  SetNumber("AIN2.voltage_mV", 1800);
+  SetNumber("IN2.voltage_mV", 1800);
   Advance(10ms);
   EXPECT_EQ(TryWrite(0x6125, 2, 0x12345678, 4), SdoAborted(0x6125, 2, 0x06090030));
   Write(0x6125, 2, 0x6F72657A, 4);
   EXPECT_EQ(Read(0x7124, 2, true), -1800);
   EXPECT_EQ(Read(0x7130, 2, true), 0);
-  SetNumber("AIN2.voltage_mV", 2000);
+  SetNumber("IN2.voltage_mV", 2000);
   Advance(10ms);
   EXPECT_EQ(Read(0x7130, 2, true), 200);
   EXPECT_EQ(Sdo(SdoRead(0x6125, 2)), SdoAborted(0x6125, 2, 0x06010001));  // write-only
@@ -103,12 +103,12 @@ TEST_F(QuadAiTest, AutozeroMakesTheProcessValueZero) {
 // §3.3.23: moving average V_N = V_{N-1} + (Input − V_{N-1}) / C on the process value; the field
 // value stays the measurement.
 TEST_F(QuadAiTest, MovingAverageFiltersTheProcessValue) {
-  SetNumber("AIN1.voltage_mV", 1000);
+  SetNumber("IN1.voltage_mV", 1000);
   Write(0x61A0, 1, 1, 1);
   Write(0x61A1, 1, 4, 1);
   Advance(10ms);
   EXPECT_EQ(Read(0x7130, 1), 1000);  // starts from the first sample
-  SetNumber("AIN1.voltage_mV", 2000);
+  SetNumber("IN1.voltage_mV", 2000);
   Advance(10ms);
   EXPECT_EQ(Read(0x7100, 1), 2000);
   EXPECT_EQ(Read(0x7130, 1), 1250);  // 1000 + (2000 − 1000) / 4
@@ -122,15 +122,15 @@ TEST_F(QuadAiTest, MovingAverageFiltersTheProcessValue) {
 TEST_F(QuadAiTest, RepeatingAverageUpdatesEveryNthSample) {
   Write(0x61A0, 3, 2, 1);
   Write(0x61A1, 3, 3, 1);
-  SetNumber("AIN3.voltage_mV", 1000);
+  SetNumber("IN3.voltage_mV", 1000);
   Advance(10ms);
-  SetNumber("AIN3.voltage_mV", 2000);
+  SetNumber("IN3.voltage_mV", 2000);
   Advance(10ms);
   EXPECT_EQ(Read(0x7130, 3), 0);  // no block of 3 yet
-  SetNumber("AIN3.voltage_mV", 3000);
+  SetNumber("IN3.voltage_mV", 3000);
   Advance(10ms);
   EXPECT_EQ(Read(0x7130, 3), 2000);
-  SetNumber("AIN3.voltage_mV", 4000);
+  SetNumber("IN3.voltage_mV", 4000);
   Advance(20ms);
   EXPECT_EQ(Read(0x7130, 3), 2000);  // holds until the next third sample
   Advance(10ms);
@@ -143,7 +143,7 @@ TEST_F(QuadAiTest, FrequencyInputsAreNotFiltered) {
   Write(0x2090, 1, 10, 2);
   Write(0x61A0, 5, 1, 1);
   Write(0x61A1, 5, 100, 1);
-  SetNumber("FIN1.frequency_Hz", 5000);
+  SetNumber("IN5.frequency_Hz", 5000);
   Advance(20ms);
   EXPECT_EQ(Read(0x7130, 5), 5000);
 }
@@ -166,10 +166,10 @@ TEST_F(QuadAiTest, ADisabledInputSendsNothingOfItsOwn) {
   Write(0x20B0, 2, 0, 2);     // no error delay
   Write(0x20A0, 1, 0x02, 1);  // error checking on AIN2
   Start();
-  SetNumber("AIN1.voltage_mV", 1000);
-  SetNumber("AIN2.voltage_mV", 4900);  // above 2080h (4800): an error, were it checked
-  SetNumber("AIN3.voltage_mV", 3000);
-  SetNumber("AIN4.voltage_mV", 4000);
+  SetNumber("IN1.voltage_mV", 1000);
+  SetNumber("IN2.voltage_mV", 4900);  // above 2080h (4800): an error, were it checked
+  SetNumber("IN3.voltage_mV", 3000);
+  SetNumber("IN4.voltage_mV", 4000);
   Advance(99ms);  // t = 100 ms: the event timers
   std::vector<std::string> tpdo1, emcy;
   for (const auto& f : Frames()) {
@@ -195,7 +195,7 @@ TEST_F(QuadAiTest, ATpdoOfOnlyDisabledInputsIsNotSent) {
   Advance(299ms);
   EXPECT_TRUE(Frames("185#").empty());
   Write(0x6112, 3, 1, 1);  // AIN3 in use again
-  SetNumber("AIN3.voltage_mV", 3000);
+  SetNumber("IN3.voltage_mV", 3000);
   Advance(200ms);
   EXPECT_FALSE(Frames("185#").empty());
 }

@@ -13,7 +13,7 @@ using quad::ProfileInputs;
 
 class QuadAoTest : public QuadTest {
  protected:
-  double Current(int n) { return io().Number("POUT" + std::to_string(n) + ".current_mA"); }
+  double Current(int n) { return io().Number("OUT" + std::to_string(n) + ".current_mA"); }
 };
 
 // §3.1.1 RPDO1 maps 7330h.1-4; §3.5.10 30A0h default 2: no ramps under CAN control; §3.5.12 the
@@ -26,8 +26,8 @@ TEST_F(QuadAoTest, Rpdo1SetsTheCurrentsAndTpdo4ReportsThem) {
   EXPECT_EQ(Current(2), 2000);
   EXPECT_EQ(Current(3), 500);
   EXPECT_EQ(Current(4), 0);
-  EXPECT_TRUE(io().Bool("POUT1.on"));
-  EXPECT_FALSE(io().Bool("POUT4.on"));
+  EXPECT_TRUE(io().Bool("OUT1.on"));
+  EXPECT_FALSE(io().Bool("OUT4.on"));
   Frames();
   Advance(98ms);  // t = 100 ms: the event timers
   EXPECT_EQ(Frames("485#"), std::vector<std::string>{"485#E803D007F4010000"});
@@ -68,7 +68,7 @@ TEST_F(QuadAoTest, RampsFollowTheRampTimesOverSimulatedTime) {
 TEST_F(QuadAoTest, RampControlZeroStepsAtOnce) {
   Write(0x30A0, 2, 0, 1);
   Write(0x3010, 2, 2, 1);  // POUT2 ← AIN2
-  SetNumber("AIN2.voltage_mV", 4500);
+  SetNumber("IN2.voltage_mV", 4500);
   Advance(10ms);
   EXPECT_EQ(Current(2), 1500);
 }
@@ -76,15 +76,15 @@ TEST_F(QuadAoTest, RampControlZeroStepsAtOnce) {
 // §2.6, §3.5.1-2: an input drives the output through its profile, in pre-operational as well;
 // ramps (30A0h = 2) apply: 3080h is the time from 0 to the highest profile current (1500 mA).
 TEST_F(QuadAoTest, AnInputDrivesTheOutputThroughItsProfileWithRamps) {
-  Write(0x3010, 1, 1, 1);              // POUT1 ← AIN1, single profile single slope
-  SetNumber("AIN1.voltage_mV", 2500);  // (2500 − 500) / (4500 − 500) × 1500 = 750 mA
-  Advance(10ms);                       // first sample and first step: 1 mA
+  Write(0x3010, 1, 1, 1);             // POUT1 ← AIN1, single profile single slope
+  SetNumber("IN1.voltage_mV", 2500);  // (2500 − 500) / (4500 − 500) × 1500 = 750 mA
+  Advance(10ms);                      // first sample and first step: 1 mA
   EXPECT_NEAR(Current(1), 1, 0.01);
   Advance(374ms);
   EXPECT_NEAR(Current(1), 375, 0.01);
   Advance(400ms);
   EXPECT_EQ(Current(1), 750);
-  SetNumber("AIN1.voltage_mV", 4700);  // above 2070h: the maximum current
+  SetNumber("IN1.voltage_mV", 4700);  // above 2070h: the maximum current
   Advance(1000ms);
   EXPECT_EQ(Current(1), 1500);
 }
@@ -94,7 +94,7 @@ TEST_F(QuadAoTest, InputControlNeedsNormalMode) {
   Write(0x30A0, 1, 0, 1);
   Write(0x3010, 1, 1, 1);
   Write(0x6112, 1, 20, 1);
-  SetNumber("AIN1.voltage_mV", 4500);
+  SetNumber("IN1.voltage_mV", 4500);
   Advance(20ms);
   EXPECT_EQ(Current(1), 0);
 }
@@ -145,11 +145,11 @@ TEST_F(QuadAoTest, DitherIsSuperimposedWhileTheOutputDrivesCurrent) {
   Write(0x3070, 1, 100, 2);
   Write(0x3060, 1, 300, 2);
   Start();
-  EXPECT_EQ(io().Number("POUT1.dither_mA"), 0);
+  EXPECT_EQ(io().Number("OUT1.dither_mA"), 0);
   Send("205#E803000000000000");
   Advance(1ms);
-  EXPECT_EQ(io().Number("POUT1.dither_mA"), 100);
-  EXPECT_EQ(io().Number("POUT1.dither_Hz"), 300);
+  EXPECT_EQ(io().Number("OUT1.dither_mA"), 100);
+  EXPECT_EQ(io().Number("OUT1.dither_Hz"), 300);
   EXPECT_EQ(Read(0x30C0, 1), 1000);                                          // the mean current
   EXPECT_EQ(TryWrite(0x3060, 1, 40, 2), SdoAborted(0x3060, 1, 0x06090032));  // 50-400 Hz
 }
@@ -160,24 +160,24 @@ TEST_F(QuadAoTest, DitherIsSuperimposedWhileTheOutputDrivesCurrent) {
 // none. The waveform itself is not sampled (README choice 20): amplitude and frequency are
 // reported, 30C0h is the mean current.
 TEST_F(QuadAoTest, DitherAppliesUnderInputControlButNotToADigitalOutput) {
-  Write(0x30A0, 1, 0, 1);              // no ramps
-  Write(0x3010, 1, 1, 1);              // POUT1 <- AIN1, single profile
-  Write(0x3070, 1, 250, 2);            // 250 mA
-  Write(0x3060, 1, 80, 2);             // 80 Hz
-  SetNumber("AIN1.voltage_mV", 4500);  // 2070h: the maximum current, 1500 mA
+  Write(0x30A0, 1, 0, 1);             // no ramps
+  Write(0x3010, 1, 1, 1);             // POUT1 <- AIN1, single profile
+  Write(0x3070, 1, 250, 2);           // 250 mA
+  Write(0x3060, 1, 80, 2);            // 80 Hz
+  SetNumber("IN1.voltage_mV", 4500);  // 2070h: the maximum current, 1500 mA
   Advance(10ms);
   EXPECT_EQ(Current(1), 1500);
-  EXPECT_EQ(io().Number("POUT1.dither_mA"), 250);
-  EXPECT_EQ(io().Number("POUT1.dither_Hz"), 80);
+  EXPECT_EQ(io().Number("OUT1.dither_mA"), 250);
+  EXPECT_EQ(io().Number("OUT1.dither_Hz"), 80);
   EXPECT_EQ(Read(0x30C0, 1), 1500);
 
   Write(0x6310, 1, 1000, 2);  // §3.5.15: POUT1 becomes a digital output
   Write(0x3001, 1, 1, 1);     // §3.4.1: controlled by AIN1 as ON/OFF (4500 mV >= 2002h 3500 mV)
   Advance(10ms);
-  EXPECT_TRUE(io().Bool("POUT1.on"));
+  EXPECT_TRUE(io().Bool("OUT1.on"));
   EXPECT_EQ(Current(1), 1000);  // the load's current
-  EXPECT_EQ(io().Number("POUT1.dither_mA"), 0);
-  EXPECT_EQ(io().Number("POUT1.dither_Hz"), 0);
+  EXPECT_EQ(io().Number("OUT1.dither_mA"), 0);
+  EXPECT_EQ(io().Number("OUT1.dither_Hz"), 0);
 }
 
 // §1.1 "Total current consumption of all the outputs combined must not exceed 6A" and Appendix A
@@ -191,8 +191,8 @@ TEST_F(QuadAoTest, TheSixAmpereTotalIsARatingNotALimit) {
   Send("305#10");                // RPDO2: 6200h bit 4, DOUT on
   Advance(1ms);
   for (int n = 1; n <= 4; ++n)
-    EXPECT_EQ(Current(n), 2000) << "POUT" << n;
-  EXPECT_TRUE(io().Bool("DOUT.on"));
+    EXPECT_EQ(Current(n), 2000) << "OUT" << n;
+  EXPECT_TRUE(io().Bool("OUT5.on"));
   Advance(2000ms);  // longer than every error delay
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Read(0x1001, 0), 0);
@@ -205,10 +205,10 @@ TEST_F(QuadAoTest, PreOperationalRefusesOutputWritesAndAnOpenLoadDrawsNothing) {
   EXPECT_EQ(TryWrite(0x7330, 1, 500, 2), SdoAborted(0x7330, 1, 0x08000022));
   EXPECT_EQ(TryWrite(0x7F50, 1, 500, 2), SdoAborted(0x7F50, 1, 0x08000022));
   Start();
-  SetEnum("POUT1.load", "open");
+  SetEnum("OUT1.load", "open");
   Write(0x7330, 1, 500, 2);
   Advance(1ms);
-  EXPECT_TRUE(io().Bool("POUT1.on"));
+  EXPECT_TRUE(io().Bool("OUT1.on"));
   EXPECT_EQ(Current(1), 0);
   EXPECT_EQ(Read(0x30C0, 1), 0);
 }

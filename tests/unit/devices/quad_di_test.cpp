@@ -18,12 +18,12 @@ TEST_F(QuadDiTest, DigitalModeFollowsTheActiveLevel) {
   Write(0x2000, 1, 0x3D, 1);  // DIN2 active low, the others active high
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
-  SetEnum("DIN1.level", "high");
-  SetEnum("DIN2.level", "low");
+  SetEnum("IN1.level", "high");
+  SetEnum("IN2.level", "low");
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0x03);
-  SetEnum("DIN1.level", "low");
-  SetEnum("DIN2.level", "high");
+  SetEnum("IN1.level", "low");
+  SetEnum("IN2.level", "high");
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
 }
@@ -34,7 +34,7 @@ TEST_F(QuadDiTest, PolarityInvertsDigitalInputs) {
   Write(0x6002, 1, 0x20, 1);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0x20);  // floating, inverted: on
-  SetEnum("DIN6.level", "high");
+  SetEnum("IN6.level", "high");
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
 }
@@ -43,29 +43,29 @@ TEST_F(QuadDiTest, PolarityInvertsDigitalInputs) {
 TEST_F(QuadDiTest, OnOffModeHasHysteresisAndIgnoresPolarity) {
   Write(0x6112, 3, 20, 1);
   Write(0x6002, 1, 0x04, 1);
-  SetNumber("AIN3.voltage_mV", 3600);
+  SetNumber("IN3.voltage_mV", 3600);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0x04);
-  SetNumber("AIN3.voltage_mV", 2000);
+  SetNumber("IN3.voltage_mV", 2000);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0x04);
-  SetNumber("AIN3.voltage_mV", 1500);
+  SetNumber("IN3.voltage_mV", 1500);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
-  SetNumber("AIN3.voltage_mV", 3400);
+  SetNumber("IN3.voltage_mV", 3400);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
   // Thresholds are in the field value units of the input: 0.01 % for a PWM FIN.
   Write(0x6112, 5, 20, 1);
-  SetNumber("FIN1.duty_pct", 80);
+  SetNumber("IN5.duty_pct", 80);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0x10);
 }
 
 // §3.2.4: inputs not in digital or ON/OFF mode read 0, whatever the pin.
 TEST_F(QuadDiTest, OtherModesReadZero) {
-  SetEnum("DIN1.level", "high");
-  SetNumber("AIN1.voltage_mV", 4000);
+  SetEnum("IN1.level", "high");
+  SetNumber("IN1.voltage_mV", 4000);
   Advance(10ms);
   EXPECT_EQ(ReadState(), 0);
 }
@@ -77,7 +77,7 @@ TEST_F(QuadDiTest, AChangeOfStateSendsTpdo3) {
   Write(0x6112, 1, 10, 1);
   Advance(10ms);
   EXPECT_TRUE(Frames("385#").empty());
-  SetEnum("DIN1.level", "high");
+  SetEnum("IN1.level", "high");
   Advance(10ms);
   EXPECT_EQ(Frames(), std::vector<std::string>{"385#0100"});
   Advance(50ms);

@@ -7,7 +7,7 @@ namespace {
 
 class QuadDoTest : public QuadTest {
  protected:
-  bool Dout() { return io().Bool("DOUT.on"); }
+  bool Dout() { return io().Bool("OUT5.on"); }
 };
 
 // §3.1.1 RPDO2 (6200h.1) → §3.4.5: bit 4 switches DOUT; 300Ch reports it and TPDO3 carries it.
@@ -47,14 +47,14 @@ TEST_F(QuadDoTest, CanControlledOutputsAreOffOutsideOperational) {
 // mode) drives the output in pre-operational too; stopped turns it off.
 TEST_F(QuadDoTest, AnInputControlsTheOutputWithoutTheBus) {
   Write(0x3001, 5, 1, 1);  // DOUT ← AIN1
-  SetNumber("AIN1.voltage_mV", 4000);
+  SetNumber("IN1.voltage_mV", 4000);
   Advance(11ms);
   EXPECT_TRUE(Dout());
   EXPECT_EQ(Read(0x6000, 1), 0);  // AIN1 stays a normal analog input
-  SetNumber("AIN1.voltage_mV", 1000);
+  SetNumber("IN1.voltage_mV", 1000);
   Advance(10ms);
   EXPECT_FALSE(Dout());
-  SetNumber("AIN1.voltage_mV", 4000);
+  SetNumber("IN1.voltage_mV", 4000);
   Send("000#0205");
   Advance(10ms);
   EXPECT_FALSE(Dout());
@@ -63,7 +63,7 @@ TEST_F(QuadDoTest, AnInputControlsTheOutputWithoutTheBus) {
 // §3.4.1 note 2: control inputs 11-16 read OFF unless that input is in digital mode.
 TEST_F(QuadDoTest, DigitalInputControlNeedsDigitalMode) {
   Write(0x3001, 5, 12, 1);  // DOUT ← DIN2
-  SetEnum("DIN2.level", "high");
+  SetEnum("IN2.level", "high");
   Advance(11ms);
   EXPECT_FALSE(Dout());
   Write(0x6112, 2, 10, 1);
@@ -99,13 +99,13 @@ TEST_F(QuadDoTest, LatchedResponseTogglesOnEachNewOn) {
   Write(0x6112, 1, 10, 1);
   Advance(11ms);
   EXPECT_FALSE(Dout());
-  SetEnum("DIN1.level", "high");
+  SetEnum("IN1.level", "high");
   Advance(10ms);
   EXPECT_TRUE(Dout());
-  SetEnum("DIN1.level", "open");
+  SetEnum("IN1.level", "open");
   Advance(10ms);
   EXPECT_TRUE(Dout());
-  SetEnum("DIN1.level", "high");
+  SetEnum("IN1.level", "high");
   Advance(10ms);
   EXPECT_FALSE(Dout());
 }
@@ -116,17 +116,17 @@ TEST_F(QuadDoTest, PoutConfiguredAsDigitalIsADigitalOutput) {
   Start();
   SilenceTpdoTimers();
   Write(0x6310, 1, 1000, 2);
-  SetNumber("POUT1.load_current_mA", 800);
+  SetNumber("OUT1.load_current_mA", 800);
   Send("305#01");
   Advance(1ms);
-  EXPECT_TRUE(io().Bool("POUT1.on"));
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 800);
+  EXPECT_TRUE(io().Bool("OUT1.on"));
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 800);
   EXPECT_EQ(Read(0x30C0, 1), 800);
   EXPECT_EQ(Frames(), std::vector<std::string>{"385#0001"});
   // In current mode the 6200h bit is ignored and 300Ch reads 0 for it.
   Write(0x6310, 1, 20, 2);
   Advance(1ms);
-  EXPECT_FALSE(io().Bool("POUT1.on"));
+  EXPECT_FALSE(io().Bool("OUT1.on"));
   EXPECT_EQ(Read(0x300C, 1), 0);
 }
 

@@ -13,7 +13,7 @@ class QuadFaultTest : public QuadTest {
   void MakeAin1Low(std::uint16_t delay_ms) {
     Write(0x20B0, 1, delay_ms, 2);
     Write(0x20A0, 1, 0x01, 1);
-    SetNumber("AIN1.voltage_mV", 100);
+    SetNumber("IN1.voltage_mV", 100);
   }
   std::uint32_t Entry(std::uint8_t sub) { return static_cast<std::uint32_t>(Read(0x1003, sub)); }
 };
@@ -32,7 +32,7 @@ TEST_F(QuadFaultTest, InputBelowErrorMinimumBecomesActiveAfterTheDelay) {
   EXPECT_EQ(Read(0x1003, 0), 1);
   EXPECT_EQ(Entry(1), 0x0101FF00u);
   EXPECT_EQ(Read(0x1001, 0), 0x01);
-  SetNumber("AIN1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Advance(10ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{"085#0000000000000000"});
   EXPECT_EQ(Read(0x1003, 0), 0);
@@ -43,7 +43,7 @@ TEST_F(QuadFaultTest, InputBelowErrorMinimumBecomesActiveAfterTheDelay) {
 TEST_F(QuadFaultTest, AFaultGoneDuringTheDelayIsNeverReported) {
   MakeAin1Low(500);
   Advance(300ms);
-  SetNumber("AIN1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Advance(1000ms);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Read(0x1003, 0), 0);
@@ -53,7 +53,7 @@ TEST_F(QuadFaultTest, AFaultGoneDuringTheDelayIsNeverReported) {
 TEST_F(QuadFaultTest, InputAboveErrorMaximumWithZeroDelay) {
   Write(0x20B0, 2, 0, 2);
   Write(0x20A0, 1, 0x02, 1);
-  SetNumber("AIN2.voltage_mV", 4900);
+  SetNumber("IN2.voltage_mV", 4900);
   Advance(10ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0xFF01, 0x01, 2, 0x01)});
   EXPECT_EQ(Entry(1), 0x0102FF01u);
@@ -83,7 +83,7 @@ TEST_F(QuadFaultTest, AnalogInputFaultAppliesErrorBehaviourSub3) {
 TEST_F(QuadFaultTest, ShortCircuitOnPout3IsTheManualsExample) {
   Write(0x1029, 5, 0, 1);
   Start();
-  SetEnum("POUT3.load", "short");
+  SetEnum("OUT3.load", "short");
   Advance(1000ms);
   EXPECT_TRUE(Frames("085#").empty());
   Advance(1ms);
@@ -99,11 +99,11 @@ TEST_F(QuadFaultTest, OpenCircuitsByOutputMode) {
   Write(0x6310, 2, 1000, 2);
   Write(0x300B, 2, 0, 2);
   Write(0x300B, 5, 0, 2);
-  SetEnum("POUT1.load", "open");
+  SetEnum("OUT1.load", "open");
   Advance(1ms);
-  SetEnum("POUT2.load", "open");
+  SetEnum("OUT2.load", "open");
   Advance(1ms);
-  SetEnum("DOUT.load", "short");
+  SetEnum("OUT5.load", "short");
   Advance(1ms);
   EXPECT_EQ(Frames("085#"), (std::vector<std::string>{"085#0033010104000000", "085#0033010202000000",
                                                       "085#02FF010502000000"}));
@@ -112,7 +112,7 @@ TEST_F(QuadFaultTest, OpenCircuitsByOutputMode) {
   EXPECT_EQ(Entry(2), 0x02023300u);
   EXPECT_EQ(Entry(3), 0x04013300u);
   // Repaired: each clears with an error reset; the last one leaves 1001h at 0.
-  SetEnum("POUT2.load", "nominal");
+  SetEnum("OUT2.load", "nominal");
   Advance(1ms);
   EXPECT_EQ(Read(0x1003, 0), 2);
   EXPECT_EQ(Entry(1), 0x0205FF02u);
@@ -145,23 +145,23 @@ TEST_F(QuadFaultTest, FaultStateDrivesOutputsToTheirFaultValues) {
   Send("305#10");
   Send("205#E803000000000000");
   Advance(1ms);
-  ASSERT_TRUE(io().Bool("DOUT.on"));
-  ASSERT_EQ(io().Number("POUT1.current_mA"), 1000);
+  ASSERT_TRUE(io().Bool("OUT5.on"));
+  ASSERT_EQ(io().Number("OUT1.current_mA"), 1000);
   MakeAin1Low(0);
   Advance(10ms);
   EXPECT_TRUE(quad().FaultState());
-  EXPECT_FALSE(io().Bool("DOUT.on"));
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 0);
+  EXPECT_FALSE(io().Bool("OUT5.on"));
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 0);
   EXPECT_EQ(Read(0x7330, 1), 0);
   EXPECT_EQ(Read(0x300C, 1), 0);
-  SetNumber("AIN1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Advance(10ms);
   EXPECT_FALSE(quad().FaultState());
-  EXPECT_TRUE(io().Bool("DOUT.on"));
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 0);
+  EXPECT_TRUE(io().Bool("OUT5.on"));
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 0);
   Send("205#E803000000000000");
   Advance(1ms);
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 1000);
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 1000);
 }
 
 // §3.4.7-8, §3.5.21-22: fault mode 0 keeps operating; fault state bit 1 drives on; a fault FV is
@@ -177,12 +177,12 @@ TEST_F(QuadFaultTest, FaultModesAndFaultValuesAreConfigurable) {
   Advance(1ms);
   MakeAin1Low(0);
   Advance(10ms);
-  EXPECT_FALSE(io().Bool("DOUT.on"));  // keeps operating: 6200h = 0
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 300);
-  EXPECT_EQ(io().Number("POUT2.current_mA"), 1000);
+  EXPECT_FALSE(io().Bool("OUT5.on"));  // keeps operating: 6200h = 0
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 300);
+  EXPECT_EQ(io().Number("OUT2.current_mA"), 1000);
   Write(0x6206, 1, 0x1F, 1);
   Advance(1ms);
-  EXPECT_TRUE(io().Bool("DOUT.on"));  // driven to 6207h bit 4 = on
+  EXPECT_TRUE(io().Bool("OUT5.on"));  // driven to 6207h bit 4 = on
 }
 
 // §4.2 "Pre-Operational Behaviour": the fault state applies in pre-operational too; "Stopped
@@ -192,12 +192,12 @@ TEST_F(QuadFaultTest, FaultStateInPreOperationalAndStopped) {
   Write(0x7341, 4, 700, 2);
   MakeAin1Low(0);
   Advance(10ms);
-  EXPECT_TRUE(io().Bool("DOUT.on"));
-  EXPECT_EQ(io().Number("POUT4.current_mA"), 700);
+  EXPECT_TRUE(io().Bool("OUT5.on"));
+  EXPECT_EQ(io().Number("OUT4.current_mA"), 700);
   Send("000#0205");
   Advance(1ms);
-  EXPECT_FALSE(io().Bool("DOUT.on"));
-  EXPECT_EQ(io().Number("POUT4.current_mA"), 0);
+  EXPECT_FALSE(io().Bool("OUT5.on"));
+  EXPECT_EQ(io().Number("OUT4.current_mA"), 0);
 }
 
 // §3.1.7, §4.2: a lost heartbeat is 8130h with description 08h and the node-ID as channel
@@ -227,11 +227,11 @@ TEST_F(QuadFaultTest, LostHeartbeatWithoutStateChangeStillSetsTheFaultState) {
   Send("305#10");
   Send("707#05");
   Advance(1ms);
-  ASSERT_TRUE(io().Bool("DOUT.on"));
+  ASSERT_TRUE(io().Bool("OUT5.on"));
   Advance(50ms);
   EXPECT_EQ(stack().State(), canopen::NmtState::kOperational);
   EXPECT_EQ(Entry(1), 0x08078130u);
-  EXPECT_FALSE(io().Bool("DOUT.on"));
+  EXPECT_FALSE(io().Bool("OUT5.on"));
 }
 
 // §4.2 "Upon reset of the controller, all possible faults ... are in the inactive state": a reset

@@ -11,7 +11,7 @@ class QuadIdleTest : public QuadTest {
  protected:
   /// Advances to `t` after power-on (simulated time starts at 0).
   void AdvanceTo(Duration t) { scheduler_.AdvanceTo(TimePoint{t}); }
-  double Current(int n) { return io().Number("POUT" + std::to_string(n) + ".current_mA"); }
+  double Current(int n) { return io().Number("OUT" + std::to_string(n) + ".current_mA"); }
   /// POUT1 ← AIN1 through the default profile: 2500 mV gives 750 mA, ramped at 1 mA/ms (3080h
   /// 1500 ms for 0 → 1500 mA, the profile's highest current); settled well before 1 s.
   void DriveOutput1FromInput1() {
@@ -56,7 +56,7 @@ TEST_F(QuadIdleTest, AnIdleOperationalQuadWakesOnlyForItsTpdoTimersAndHeartbeat)
 TEST_F(QuadIdleTest, AnInputSetWhileAsleepIsSampledAndRampedOnTheFixedGrid) {
   DriveOutput1FromInput1();
   AdvanceTo(5s + 3500us);
-  SetNumber("AIN1.voltage_mV", 4500);  // target 1500 mA
+  SetNumber("IN1.voltage_mV", 4500);  // target 1500 mA
   AdvanceTo(5010ms - 1ns);
   EXPECT_EQ(od().GetUnsigned(0x7100, 1), 2500u);
   EXPECT_EQ(Current(1), 750);
@@ -78,7 +78,7 @@ TEST_F(QuadIdleTest, AFaultDelayEndsAndItsReactionHappensAtTheSameInstant) {
   Write(0x20B0, 2, 1000, 2);
   Write(0x20A0, 1, 0x02, 1);  // error checking on AIN2
   AdvanceTo(5s + 3500us);
-  SetNumber("AIN2.voltage_mV", 100);  // below 2010h = 200 mV: pending at the 5.010 s sample
+  SetNumber("IN2.voltage_mV", 100);  // below 2010h = 200 mV: pending at the 5.010 s sample
   AdvanceTo(6010ms - 1ns);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Current(1), 750);

@@ -63,8 +63,8 @@ TEST_F(QuadNmtTest, SavingDoesNotStoreOutputCommands) {
   EXPECT_EQ(Read(0x7330, 1), 0);
   EXPECT_EQ(Read(0x6200, 1), 0);
   EXPECT_EQ(Read(0x3080, 1), 800);
-  EXPECT_EQ(io().Number("POUT1.current_mA"), 0);
-  EXPECT_FALSE(io().Bool("DOUT.on"));
+  EXPECT_EQ(io().Number("OUT1.current_mA"), 0);
+  EXPECT_FALSE(io().Bool("OUT5.on"));
 }
 
 // §4.2 "Stopped Behaviour": only NMT and error control; no SDO, no outputs.

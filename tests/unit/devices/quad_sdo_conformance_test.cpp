@@ -23,9 +23,9 @@ class QuadSdoConformanceTest : public QuadTest {
     client_port_.OnReceive([this](const CanFrame& frame, BusTime) { client_.OnFrame(frame); });
     // Inputs at 0 V / 0 % make the measured objects (7100h, 7130h) read their EDS default 0.
     for (int i = 1; i <= 4; ++i)
-      SetNumber("AIN" + std::to_string(i) + ".voltage_mV", 0);
-    SetNumber("FIN1.duty_pct", 0);
-    SetNumber("FIN2.duty_pct", 0);
+      SetNumber("IN" + std::to_string(i) + ".voltage_mV", 0);
+    SetNumber("IN5.duty_pct", 0);
+    SetNumber("IN6.duty_pct", 0);
     Advance(10ms);
   }
 

@@ -63,7 +63,7 @@ TEST(EncoderSignalsTest, DeclaredWithoutADevice) {
   SimulatedIo io;
   DeclareEncoderSignals(io);
   for (const char* name : {"ENC.speed_rpm", "ENC.position_counts", "ENC.direction", "IN1.frequency_Hz",
-                           "IN2.duty_pct", "IN1.level", "VPS.voltage_V", "TEMP.temperature_C", "OUT1.load",
+                           "IN2.duty_pct", "IN1.level", "VPS.voltage_mV", "TEMP.temperature_C", "OUT1.load",
                            "OUT2.current_mA", "OUT1.on", "ENC.shaft_counts"})
     EXPECT_NE(io.Find(name), nullptr) << name;
 }

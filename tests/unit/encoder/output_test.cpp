@@ -32,7 +32,7 @@ TEST_F(OutputTest, RpdoControlsTheCurrentThroughTheRamp) {
   Advance(100ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);
   EXPECT_TRUE(On("OUT1.on"));
-  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_V"), 8.0);  // 1 A x 8 ohm
+  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_mV"), 8000);  // 1 A x 8 ohm
   EXPECT_EQ(Out("OUT1.frequency_Hz"), 25000);
   EXPECT_EQ(Read(0x7330, 1, true), 1000);
   EXPECT_EQ(Read(0x2370, 1, true), 1000);
@@ -135,7 +135,7 @@ TEST_F(OutputTest, VoltageOutput) {
   Start();
   Rpdo1(120, 0);  // 12.0 V
   Advance(1ms);
-  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_V"), 12.0);
+  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_mV"), 12000);
   EXPECT_DOUBLE_EQ(Out("OUT1.current_mA"), 1500.0);
   EXPECT_DOUBLE_EQ(Out("OUT1.duty_pct"), 50.0);
   EXPECT_EQ(Read(0x7330, 1, true), 120);
@@ -156,7 +156,7 @@ TEST_F(OutputTest, PwmOutputFrequency) {
   Write(0x6310, 2, 40, 2);
   Advance(1ms);
   EXPECT_EQ(Out("OUT1.frequency_Hz"), 2000);
-  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_V"), 6.0);
+  EXPECT_DOUBLE_EQ(Out("OUT1.voltage_mV"), 6000);
 }
 
 // Figure 5: a hotshot output drives 2000 mA for 1000 ms, then holds 500 mA; the device sleeps

@@ -34,7 +34,7 @@ TEST_F(SupplyTest, MeasuredValues) {
   EXPECT_DOUBLE_EQ(Real(0x5030, 0), 25.0);
   EXPECT_DOUBLE_EQ(Real(0x5040, 1), 250.0);
   EXPECT_DOUBLE_EQ(Real(0x5040, 2), 240.0);
-  SetNumber("VPS.voltage_V", 12.5);
+  SetNumber("VPS.voltage_mV", 12500);
   Advance(1ms);
   EXPECT_DOUBLE_EQ(Real(0x5020, 0), 12.5);
   EXPECT_DOUBLE_EQ(Real(0x5040, 3), 125.0);
@@ -44,7 +44,7 @@ TEST_F(SupplyTest, MeasuredValues) {
 // off; the fault clears at 5042h.2 (48.0 V), not before.
 TEST_F(SupplyTest, OverVoltageAfterItsDelaySwitchesOutputsOffUntilTheClearThreshold) {
   DriveOutput1();
-  SetNumber("VPS.voltage_V", 51);
+  SetNumber("VPS.voltage_mV", 51000);
   Advance(1000ms);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);
@@ -52,10 +52,10 @@ TEST_F(SupplyTest, OverVoltageAfterItsDelaySwitchesOutputsOffUntilTheClearThresh
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0x3000, 0, 0x20)});
   EXPECT_EQ(Read(0x1003, 1), 0x20003000);
   EXPECT_EQ(Out("OUT1.current_mA"), 0);
-  SetNumber("VPS.voltage_V", 49);
+  SetNumber("VPS.voltage_mV", 49000);
   Advance(10ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 0);
-  SetNumber("VPS.voltage_V", 47.5);
+  SetNumber("VPS.voltage_mV", 47500);
   Advance(1ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{"085#0000000000000000"});
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);
@@ -63,12 +63,12 @@ TEST_F(SupplyTest, OverVoltageAfterItsDelaySwitchesOutputsOffUntilTheClearThresh
 
 // A value that leaves before its delay raises nothing; the device sleeps through the delay.
 TEST_F(SupplyTest, ABriefExcursionIsNotAFault) {
-  SetNumber("VPS.voltage_V", 55);
+  SetNumber("VPS.voltage_mV", 55000);
   Advance(1ms);
   const auto evaluations = device().Evaluations();
   Advance(500ms);
   EXPECT_EQ(device().Evaluations(), evaluations);
-  SetNumber("VPS.voltage_V", 24);
+  SetNumber("VPS.voltage_mV", 24000);
   Advance(2000ms);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Read(0x1003, 0), 0);
@@ -78,20 +78,20 @@ TEST_F(SupplyTest, ABriefExcursionIsNotAFault) {
 // once (hardware), before any delay.
 TEST_F(SupplyTest, UnderVoltageAndHardwareShutdown) {
   DriveOutput1();
-  SetNumber("VPS.voltage_V", 7);
+  SetNumber("VPS.voltage_mV", 7000);
   Advance(1ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 0);
-  SetNumber("VPS.voltage_V", 8.5);
+  SetNumber("VPS.voltage_mV", 8500);
   Advance(1ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);  // 8.5 V / 8 ohm = 1062 mA: enough
   Advance(1000ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0x3000, 0, 0x40)});
   EXPECT_EQ(Read(0x1003, 1), 0x40003000);
   EXPECT_EQ(Out("OUT1.current_mA"), 0);
-  SetNumber("VPS.voltage_V", 11);
+  SetNumber("VPS.voltage_mV", 11000);
   Advance(5ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 0);
-  SetNumber("VPS.voltage_V", 12);
+  SetNumber("VPS.voltage_mV", 12000);
   Advance(1ms);
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);
 }
@@ -120,7 +120,7 @@ TEST_F(SupplyTest, OverTemperatureAppliesOtherFaultsBehaviour) {
 TEST_F(SupplyTest, DisabledChecksRaiseNothing) {
   Write(0x5050, 0, 0x02, 1);
   DriveOutput1();
-  SetNumber("VPS.voltage_V", 55);
+  SetNumber("VPS.voltage_mV", 55000);
   Advance(2000ms);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Out("OUT1.current_mA"), 1000);

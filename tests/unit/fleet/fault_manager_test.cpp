@@ -44,6 +44,7 @@ class FaultManagerTest : public ::testing::Test {
             if (n.name() == name) return &n;
           return nullptr;
         },
+        .unknown_node = nullptr,
         .origin = scheduler.Now(),
         .on_event = [this](const control::FaultStatus& s,
                            bool started) { events.push_back((started ? "+" : "-") + s.state()); },

@@ -86,8 +86,8 @@ TEST(PsSignals, DeclaredWithoutADevice) {
   for (std::size_t i = 0; i < declared.Signals().size(); ++i)
     EXPECT_EQ(declared.Signals()[i]->name(), device.io().Signals()[i]->name());
   for (const char* name :
-       {"VIN.voltage_V", "ENABLE.level", "LOAD.resistance_ohm", "LOAD.current_A", "LOAD.mode",
-        "TEMP.temperature_C", "PS.output_on", "VOUT.voltage_V", "IOUT.current_A", "PS.state"})
+       {"VIN.voltage_mV", "ENABLE.level", "LOAD.resistance_ohm", "LOAD.current_mA", "LOAD.mode",
+        "TEMP.temperature_C", "PS.output_on", "VOUT.voltage_mV", "IOUT.current_mA", "PS.state"})
     EXPECT_NE(declared.Find(name), nullptr) << name;
 }
 

@@ -49,7 +49,7 @@ TEST_F(PsFaultTest, FactoryDefaultsRaiseNothing) {
 // input does (README choice 11).
 TEST_F(PsFaultTest, InputUnderVoltageIsFF04AfterBothDelays) {
   OnByCan();
-  SetNumber("VIN.voltage_V", 8.8);  // above the 8.5 V hardware shutdown
+  SetNumber("VIN.voltage_mV", 8800);  // above the 8.5 V hardware shutdown
   Advance(1ms);
   EXPECT_EQ(Read32(0x6112, 1), 0xFFF1FFF0u);  // Vt1 condition 00: lower than return
   EXPECT_EQ(Read32(0x6112, 3), 0xFFF0FFF0u);
@@ -72,7 +72,7 @@ TEST_F(PsFaultTest, InputUnderVoltageIsFF04AfterBothDelays) {
   EXPECT_EQ(Read(0x1001, 0), 1);
   EXPECT_EQ(Read(0x6011, 1) & 0x0F, 0x04);  // failure active, output off (README choice 17)
 
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(1ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{EmcyReset()});
   EXPECT_EQ(Read(0x1003, 0), 0);
@@ -85,9 +85,9 @@ TEST_F(PsFaultTest, InputUnderVoltageIsFF04AfterBothDelays) {
 // A condition gone during the delays is never reported.
 TEST_F(PsFaultTest, AShortDipIsNoFailure) {
   OnByCan();
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(150ms);
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(1s);
   EXPECT_TRUE(Frames("0FF#").empty());
   EXPECT_TRUE(On());
@@ -101,7 +101,7 @@ TEST_F(PsFaultTest, InputFailuresAggregateIntoOneEntry) {
   Advance(201ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{kInputFailure});
   EXPECT_EQ(Read32(0x6112, 5), 0xFFF4FFF0u);  // Tt2 (bits 19-18) on
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(300ms);
   EXPECT_EQ(Read32(0x6112, 5), 0xFFF4FFF1u);
   EXPECT_TRUE(Frames("0FF#").empty());
@@ -110,7 +110,7 @@ TEST_F(PsFaultTest, InputFailuresAggregateIntoOneEntry) {
   Advance(5ms);
   EXPECT_TRUE(Frames("0FF#").empty());
   EXPECT_FALSE(On());
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(1ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{EmcyReset()});
   EXPECT_TRUE(On());
@@ -121,16 +121,16 @@ TEST_F(PsFaultTest, InputFailuresAggregateIntoOneEntry) {
 TEST_F(PsFaultTest, ThresholdAndReturnGiveHysteresis) {
   Write(0x6114, 1, 11000, 4);
   OnByCan();
-  SetNumber("VIN.voltage_V", 10.0);  // between return 9 V and threshold 11 V: still fine
+  SetNumber("VIN.voltage_mV", 10000);  // between return 9 V and threshold 11 V: still fine
   Advance(500ms);
   EXPECT_TRUE(Frames("0FF#").empty());
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(201ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{kInputFailure});
-  SetNumber("VIN.voltage_V", 10.0);
+  SetNumber("VIN.voltage_mV", 10000);
   Advance(100ms);
   EXPECT_TRUE(Frames("0FF#").empty());  // in the band: the failure holds
-  SetNumber("VIN.voltage_V", 11.0);
+  SetNumber("VIN.voltage_mV", 11000);
   Advance(1ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{EmcyReset()});
 }
@@ -139,7 +139,7 @@ TEST_F(PsFaultTest, ThresholdAndReturnGiveHysteresis) {
 // 44 V hardware protection has already switched the output off (§3), the EMCY follows the delays.
 TEST_F(PsFaultTest, InputOverVoltage) {
   OnByCan();
-  SetNumber("VIN.voltage_V", 50.0);
+  SetNumber("VIN.voltage_mV", 50000);
   Advance(1ms);
   EXPECT_FALSE(On());
   EXPECT_EQ(State(), "protection");
@@ -154,7 +154,7 @@ TEST_F(PsFaultTest, InputOverVoltage) {
 TEST_F(PsFaultTest, FaultStateIgnoreKeepsTheOutputOn) {
   Write(0x6112, 4, 0xFFF5FFF7, 4);
   OnByCan();
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(1s);
   EXPECT_EQ(Read32(0x6112, 3), 0xFFF0FFF1u);
   EXPECT_EQ(Read32(0x6112, 5), 0xFFF0FFF0u);
@@ -220,13 +220,13 @@ TEST_F(PsFaultTest, LatchedFaultWaitsForQuitFailureOnRpdo1) {
 TEST_F(PsFaultTest, QuitFailureThroughSdoAndWhileStillFailing) {
   Write(0x2320, 0, 1, 1);
   OnByCan();
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(201ms);
   ASSERT_EQ(State(), "fault_latched");
   Write(0x6200, 3, 0xFC, 1);
   Advance(5ms);
   EXPECT_EQ(State(), "fault_latched");
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(5ms);
   EXPECT_FALSE(On());
   Write(0x6010, 2, 0xFC, 1);
@@ -238,13 +238,13 @@ TEST_F(PsFaultTest, QuitFailureThroughSdoAndWhileStillFailing) {
 // refused with 08000022h while 1001h ≠ 0 (README choice 14).
 TEST_F(PsFaultTest, ErrorBehaviourIsWritableOnlyWithoutErrors) {
   Write(0x1029, 2, 2, 1);
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(201ms);
   ASSERT_EQ(Read(0x1001, 0), 1);
   EXPECT_EQ(TryWrite(0x1029, 3, 2, 1), SdoAborted(0x1029, 3, 0x08000022));
   EXPECT_EQ(TryWrite(0x1029, 1, 1, 1), SdoAborted(0x1029, 1, 0x08000022));
   EXPECT_EQ(Read(0x1029, 3), 1);
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(1ms);
   ASSERT_EQ(Read(0x1001, 0), 0);
   Write(0x1029, 3, 2, 1);
@@ -278,7 +278,7 @@ TEST_F(PsFaultTest, OutputFailureFollows1029hSub4) {
 // sub 1-15. Writing 0 to sub 0 clears the list but "does NOT mean that the module will return to
 // the error-free behaviour state".
 TEST_F(PsFaultTest, ErrorHistoryKeepsFourAndClearingKeepsTheErrorState) {
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(201ms);
   for (std::uint8_t n = 1; n <= 4; ++n)
     stack().emcy().Raise(family::MakeFamilyEntry(0x8130, 0x80, n));

@@ -97,11 +97,11 @@ TEST_F(PsModelTest, MeasuredObjectsFollowTheModel) {
   Advance(1ms);
   EXPECT_EQ(Read(0x6204, 1), 24000);
   EXPECT_EQ(Read(0x6204, 2), 1000);
-  EXPECT_NEAR(io().Number("IIN.current_A"), 1.064, 0.0005);
+  EXPECT_NEAR(io().Number("IIN.current_mA"), 1064, 0.5);
   // §2.3.20: 6205h.1 sets the output voltage (README choice 7).
   Write(0x6205, 1, 12000, 4);
   Advance(2ms);
-  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_V"), 12.0);
+  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_mV"), 12000);
   EXPECT_EQ(Read(0x6204, 1), 12000);
   EXPECT_EQ(Read(0x6204, 2), 500);
 }
@@ -110,9 +110,9 @@ TEST_F(PsModelTest, MeasuredObjectsFollowTheModel) {
 TEST_F(PsModelTest, LowInputLowersTheOutputCeiling) {
   NoInputFilter();
   OnByCan();
-  SetNumber("VIN.voltage_V", 10.5);
+  SetNumber("VIN.voltage_mV", 10500);
   Advance(2ms);
-  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_V"), 23.5);
+  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_mV"), 23500);
   EXPECT_EQ(Read(0x6113, 1), 10500);
   EXPECT_EQ(Read(0x6204, 1), 23500);
 }
@@ -126,13 +126,13 @@ TEST_F(PsModelTest, ManufacturerCurrentLimitFollowsTheInput) {
   OnByCan();
   Advance(1ms);
   EXPECT_TRUE(io().Bool("PS.current_limited"));
-  EXPECT_DOUBLE_EQ(io().Number("PS.current_limit_A"), 15.0);
+  EXPECT_DOUBLE_EQ(io().Number("PS.current_limit_mA"), 15000);
   EXPECT_EQ(Read(0x6204, 2), 15000);
   EXPECT_EQ(Read(0x6204, 1), 15000);
-  SetNumber("VIN.voltage_V", 15.5);
+  SetNumber("VIN.voltage_mV", 15500);
   Advance(2ms);
   EXPECT_EQ(Read(0x6204, 2), 12825);  // 0.8455 × 15.5 − 0.2805 = 12.82475 A
-  EXPECT_DOUBLE_EQ(io().Number("PS.current_limit_A"), 12.825);
+  EXPECT_DOUBLE_EQ(io().Number("PS.current_limit_mA"), 12825);
   // 6201h.1 bits 3-2 and 6011h.1 bits 11-10: current limit (README choice 17).
   EXPECT_EQ(Read(0x6201, 1), 0x05);
   EXPECT_EQ(Read(0x6011, 1) & 0xC00, 0x400);
@@ -146,12 +146,12 @@ TEST_F(PsModelTest, Ds453CurrentLimitIs6205hSub8) {
   Write(0x2330, 0, 1, 1);
   Write(0x6205, 8, 5000, 4);
   SetEnum("LOAD.mode", "current");
-  SetNumber("LOAD.current_A", 8.0);
+  SetNumber("LOAD.current_mA", 8000);
   OnByCan();
   Advance(1ms);
   EXPECT_EQ(Read(0x6204, 2), 5000);
   EXPECT_EQ(Read(0x6204, 1), 15000);  // 24 V × 5 A / 8 A
-  SetNumber("VIN.voltage_V", 12.0);
+  SetNumber("VIN.voltage_mV", 12000);
   Advance(2ms);
   EXPECT_EQ(Read(0x6204, 2), 5000);
 }
@@ -163,26 +163,26 @@ TEST_F(PsModelTest, HardwareUnderAndOverVoltageProtection) {
   NoInputFilter();
   NoInputChecks();
   OnByCan();
-  SetNumber("VIN.voltage_V", 8.4);
+  SetNumber("VIN.voltage_mV", 8400);
   Advance(1ms);
   EXPECT_FALSE(io().Bool("PS.output_on"));
   EXPECT_EQ(State(), "protection");
   EXPECT_EQ(io().Enum("PS.protection"), "undervoltage");
-  SetNumber("VIN.voltage_V", 11.4);
+  SetNumber("VIN.voltage_mV", 11400);
   Advance(5ms);
   EXPECT_FALSE(io().Bool("PS.output_on"));
-  SetNumber("VIN.voltage_V", 11.5);
+  SetNumber("VIN.voltage_mV", 11500);
   Advance(1ms);
   EXPECT_TRUE(io().Bool("PS.output_on"));
   EXPECT_EQ(State(), "on");
-  SetNumber("VIN.voltage_V", 45.0);
+  SetNumber("VIN.voltage_mV", 45000);
   Advance(1ms);
   EXPECT_EQ(io().Enum("PS.protection"), "overvoltage");
   EXPECT_FALSE(io().Bool("PS.output_on"));
-  SetNumber("VIN.voltage_V", 42.5);
+  SetNumber("VIN.voltage_mV", 42500);
   Advance(5ms);
   EXPECT_FALSE(io().Bool("PS.output_on"));
-  SetNumber("VIN.voltage_V", 42.0);
+  SetNumber("VIN.voltage_mV", 42000);
   Advance(1ms);
   EXPECT_TRUE(io().Bool("PS.output_on"));
   EXPECT_TRUE(Frames("0FF#").empty());
@@ -191,7 +191,7 @@ TEST_F(PsModelTest, HardwareUnderAndOverVoltageProtection) {
 // Table 4: no filter, "Value = Input" at the next sample.
 TEST_F(PsModelTest, InputFilterNone) {
   NoInputFilter();
-  SetNumber("VIN.voltage_V", 20.0);
+  SetNumber("VIN.voltage_mV", 20000);
   Advance(1ms);
   EXPECT_EQ(Read(0x6113, 1), 20000);
 }
@@ -200,7 +200,7 @@ TEST_F(PsModelTest, InputFilterNone) {
 TEST_F(PsModelTest, InputFilterMovingAverage) {
   Write(0x2100, 1, 1, 1);
   Write(0x2101, 1, 2, 2);
-  SetNumber("VIN.voltage_V", 20.0);
+  SetNumber("VIN.voltage_mV", 20000);
   Advance(1ms);
   EXPECT_EQ(Read(0x6113, 1), 22000);
   Advance(1ms);
@@ -215,7 +215,7 @@ TEST_F(PsModelTest, InputFilterMovingAverage) {
 TEST_F(PsModelTest, InputFilterRepeatingAverage) {
   Write(0x2101, 1, 10, 2);
   Advance(20ms);
-  SetNumber("VIN.voltage_V", 20.0);
+  SetNumber("VIN.voltage_mV", 20000);
   Advance(9ms);
   EXPECT_EQ(Read(0x6113, 1), 24000);
   Advance(1ms);
@@ -224,7 +224,7 @@ TEST_F(PsModelTest, InputFilterRepeatingAverage) {
 
 TEST_F(PsModelTest, DefaultInputFilterAveragesEvery200ms) {
   Advance(400ms);
-  SetNumber("VIN.voltage_V", 12.0);
+  SetNumber("VIN.voltage_mV", 12000);
   Advance(199ms);
   EXPECT_EQ(Read(0x6113, 1), 24000);
   Advance(1ms);
@@ -241,7 +241,7 @@ TEST_F(PsModelTest, AnIdleNodeDoesNotTick) {
   const auto fired = scheduler_.FiredCount();
   Advance(10s);
   EXPECT_EQ(scheduler_.FiredCount(), fired);
-  SetNumber("VIN.voltage_V", 23.0);
+  SetNumber("VIN.voltage_mV", 23000);
   Advance(1ms);
   EXPECT_TRUE(ps().LoopRunning());  // the 200-sample repeating average is settling
   Advance(400ms);
@@ -254,10 +254,10 @@ TEST_F(PsModelTest, SetVoltageIsBoundedByMinAndMax) {
   Write(0x6205, 2, 20000, 4);
   OnByCan();
   Advance(1ms);
-  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_V"), 20.0);
+  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_mV"), 20000);
   Write(0x6205, 3, 22000, 4);  // min above max: the max wins
   Advance(1ms);
-  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_V"), 20.0);
+  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_mV"), 20000);
 }
 
 }  // namespace

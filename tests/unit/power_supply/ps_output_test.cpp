@@ -23,9 +23,9 @@ TEST_F(PsOutputTest, ByDefaultTheEnablePinSwitchesTheOutput) {
   Advance(1ms);
   EXPECT_TRUE(On());
   EXPECT_EQ(State(), "on");
-  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_V"), 24.0);
-  EXPECT_DOUBLE_EQ(io().Number("IOUT.current_A"), 1.0);  // 24 ohm default load
-  Advance(1ms);                                          // measured on the next pass (§1.2.3)
+  EXPECT_DOUBLE_EQ(io().Number("VOUT.voltage_mV"), 24000);
+  EXPECT_DOUBLE_EQ(io().Number("IOUT.current_mA"), 1000);  // 24 ohm default load
+  Advance(1ms);                                            // measured on the next pass (§1.2.3)
   EXPECT_EQ(Read(0x6204, 1), 24000);
   EXPECT_EQ(Read(0x6204, 2), 1000);
   Enable(false);

@@ -35,7 +35,7 @@ TEST_F(PsTest, IssueSequenceOnLimitFailureQuitAndShutdowns) {
   // Input dropped below 6114h/611Ah (9 V) with the default 200 ms repeating average: 6113h shows
   // it within 200 ms, then 6119h.1 (100 ms) and 6013h.1 (100 ms).
   Frames();
-  SetNumber("VIN.voltage_V", 8.8);
+  SetNumber("VIN.voltage_mV", 8800);
   Advance(400ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{Emcy(0xFF04, 0x01, 0x00, 0x00)});
   EXPECT_EQ(Read(0x6112, 5), 0xFFF0FFF1);
@@ -43,7 +43,7 @@ TEST_F(PsTest, IssueSequenceOnLimitFailureQuitAndShutdowns) {
   EXPECT_FALSE(io().Bool("PS.output_on"));
 
   // Input back: the error resets, the latch holds until Quit Failure.
-  SetNumber("VIN.voltage_V", 24.0);
+  SetNumber("VIN.voltage_mV", 24000);
   Advance(250ms);
   EXPECT_EQ(Frames("0FF#"), std::vector<std::string>{EmcyReset()});
   EXPECT_FALSE(io().Bool("PS.output_on"));

@@ -53,7 +53,7 @@ TEST_F(PsSleepTest, TheEnablePinWakesIt) {
   Write(0x2311, 0, 200, 2);
   Advance(300ms);
   ASSERT_TRUE(Asleep());
-  SetNumber("VIN.voltage_V", 20.0);  // another input does not wake it
+  SetNumber("VIN.voltage_mV", 20000);  // another input does not wake it
   Advance(10ms);
   EXPECT_TRUE(Asleep());
   Enable(true);

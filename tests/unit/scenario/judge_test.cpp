@@ -227,7 +227,7 @@ TEST(SdoJudgeTest, AReadThatNeverCompletedSaysSo) {
 // ---- simulated I/O ----
 
 TEST(IoJudgeTest, NumbersWithinToleranceTextsExactlyRangesInclusive) {
-  auto number = Make("io { node: 'quad-6' name: 'POUT1.current_mA' value: '1000' }");
+  auto number = Make("io { node: 'quad-6' name: 'OUT1.current_mA' value: '1000' }");
   number->Observe(Text(kOpen, "999.6", "mA"));
   EXPECT_EQ(number->verdict().outcome, Outcome::kPassed);
   EXPECT_EQ(number->verdict().detail, "999.6 mA at t=5.000 s");
@@ -237,7 +237,7 @@ TEST(IoJudgeTest, NumbersWithinToleranceTextsExactlyRangesInclusive) {
   text->Close();
   EXPECT_EQ(text->verdict().detail, "was fault_latched at t=5.000 s");
 
-  auto range = Make("io { node: 'quad-6' name: 'POUT1.current_mA' min: 0 max: 10 }");
+  auto range = Make("io { node: 'quad-6' name: 'OUT1.current_mA' min: 0 max: 10 }");
   range->Observe(Text(kOpen, "10.5", "mA"));
   EXPECT_FALSE(range->decided());
   range->Observe(Text(kOpen + 100ms, "10", "mA"));

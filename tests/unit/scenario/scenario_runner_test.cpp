@@ -300,7 +300,7 @@ TEST_F(ScenarioRunnerTest, IoAndBusLoadArePolled) {
   probe_.io_value = "1000";
   probe_.load = 20;
   Run(R"(
-scenario { name: "out" expect { within_ms: 500 io { node: "quad-6" name: "POUT1.current_mA" min: 0 max: 10 } } }
+scenario { name: "out" expect { within_ms: 500 io { node: "quad-6" name: "OUT1.current_mA" min: 0 max: 10 } } }
 scenario { name: "load" expect { within_ms: 500 bus { load_below: 50 } } }
 )");
   scheduler_.Advance(300ms);
@@ -332,7 +332,7 @@ scenario { at_ms: 3000 clear {} }
 // among the expectations.
 TEST_F(ScenarioRunnerTest, ProgressCountsVerdictsAndNamesTheLatestStep) {
   Run(R"(
-scenario { at_ms: 1000 io { node: "quad-5" name: "AIN1.voltage_mV" value: "1800" } }
+scenario { at_ms: 1000 io { node: "quad-5" name: "IN1.voltage_mV" value: "1800" } }
 scenario { at_ms: 2000 name: "cut-hb" inject { kind: HEARTBEAT_LOSS node: "quad-5" } }
 scenario { name: "emcy" expect { after: "cut-hb" within_ms: 500 emcy { node: "quad-6" code: 0x8130 } } }
 scenario { at_ms: 3000 expect { within_ms: 100 emcy { node: "quad-6" code: 0x1000 } } }
@@ -345,7 +345,7 @@ scenario { at_ms: 3000 expect { within_ms: 100 emcy { node: "quad-6" code: 0x100
   EXPECT_EQ(p.step, "");
   scheduler_.Advance(1s);
   p = runner_->GetProgress();
-  EXPECT_EQ(p.step, "io quad-5 AIN1.voltage_mV=1800");
+  EXPECT_EQ(p.step, "io quad-5 IN1.voltage_mV=1800");
   EXPECT_EQ(p.step_time, T(1s));
   scheduler_.Advance(1s);
   EXPECT_EQ(runner_->GetProgress().step, "emcy") << "the window opened by cut-hb is the latest to begin";

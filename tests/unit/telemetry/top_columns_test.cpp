@@ -120,7 +120,7 @@ class DemoFleet : public ::testing::Test {
                       .result = telemetry::VerdictResult::kPass,
                       .name = "pout-on",
                       .line = 276,
-                      .text = "pass  topologies/demo.textproto:276  pout-on: quad-6 POUT1.current_mA in "
+                      .text = "pass  topologies/demo.textproto:276  pout-on: quad-6 OUT1.current_mA in "
                               "1100..1300 within 3000 ms after the start: 1200 mA at t=35.100 s"},
         At(kNow - 4s), nullptr);
   }

@@ -197,9 +197,9 @@ class NodeDetail : public TopFormat {
     s.tpdo_count = 1512;
     view_.Apply(s, At(kNow - 500ms), nullptr);
     IoSnapshotSample io{.bus = "can0", .node_id = 6};
-    io.inputs = {{"AIN1.voltage_mV", 1200, "mV"}, {"DIN1.level", 1, ""}};
+    io.inputs = {{"IN1.voltage_mV", 1200, "mV"}, {"IN1.level", 1, ""}};
     io.outputs = {
-        {"POUT1.current_mA", 0, "mA"}, {"VPS.voltage_V", 4.75, "V"}, {"POUT2.current_mA", 800, "mA"}};
+        {"OUT1.current_mA", 0, "mA"}, {"VPS.voltage_mV", 4750, "mV"}, {"OUT2.current_mA", 800, "mA"}};
     view_.Apply(io, At(kNow - 400ms), nullptr);
     view_.Apply(EmcySample{.bus = "can0",
                            .node_id = 6,
@@ -221,10 +221,10 @@ TEST_F(NodeDetail, ShowsStatusCountersIoWithUnitsAndTheEmcysTheBusSawNewestFirst
   EXPECT_NE(frame.find("SIMULATED OUTPUTS (3)"), std::string::npos);
   const auto lines = Lines(frame);
   const auto ain = std::find_if(lines.begin(), lines.end(),
-                                [](const std::string& l) { return l.rfind("AIN1.voltage_mV", 0) == 0; });
+                                [](const std::string& l) { return l.rfind("IN1.voltage_mV", 0) == 0; });
   ASSERT_NE(ain, lines.end());
   EXPECT_NE(ain->find("1200 mV"), std::string::npos);
-  EXPECT_NE(ain->find("POUT1.current_mA"), std::string::npos);  // outputs beside the inputs
+  EXPECT_NE(ain->find("OUT1.current_mA"), std::string::npos);  // outputs beside the inputs
   EXPECT_NE(ain->find("0 mA"), std::string::npos);
   EXPECT_NE(frame.find("4.75 V"), std::string::npos);
   EXPECT_NE(frame.find("AS THE BUS SAW THEM"), std::string::npos);

@@ -261,28 +261,28 @@ TEST(TopologyIoTest, InputsAreCheckedAgainstTheDevicesSimulatedIo) {
            "bus: \"can0\"\n" +
            io + "\n}";
   };
-  EXPECT_NO_THROW(ParseTopology(node("io { key: \"AIN1.voltage_mV\" value: \"3000\" }"), kFile));
+  EXPECT_NO_THROW(ParseTopology(node("io { key: \"IN1.voltage_mV\" value: \"3000\" }"), kFile));
   EXPECT_THAT(
-      Refusal(node("io { key: \"AIN9.voltage_mV\" value: \"3000\" }")).what(),
-      AllOf(HasSubstr(
-                ":3:6: node[0].io[0].key: quad-controller has no signal \"AIN9.voltage_mV\" (its inputs: "),
-            HasSubstr("AIN1.voltage_mV")));
-  EXPECT_THAT(Refusal(node("io { key: \"AIN1.voltage_mV\" value: \"40000\" }")).what(),
-              HasSubstr(":3:29: node[0].io[0].value: AIN1.voltage_mV: 40000 is out of range"));
-  EXPECT_THAT(Refusal(node("io { key: \"POUT1.current_mA\" value: \"1\" }")).what(),
-              HasSubstr("node[0].io[0].key: POUT1.current_mA is an output of quad-controller"));
+      Refusal(node("io { key: \"IN9.voltage_mV\" value: \"3000\" }")).what(),
+      AllOf(HasSubstr(":3:6: node[0].io[0].key: quad-controller has no signal \"IN9.voltage_mV\"; nearest: "
+                      "IN1.voltage_mV, IN2.voltage_mV, IN3.voltage_mV (its inputs: "),
+            HasSubstr("IN1.voltage_mV")));
+  EXPECT_THAT(Refusal(node("io { key: \"IN1.voltage_mV\" value: \"40000\" }")).what(),
+              HasSubstr(":3:28: node[0].io[0].value: IN1.voltage_mV: 40000 is out of range"));
+  EXPECT_THAT(Refusal(node("io { key: \"OUT1.current_mA\" value: \"1\" }")).what(),
+              HasSubstr("node[0].io[0].key: OUT1.current_mA is an output of quad-controller"));
   EXPECT_THAT(Refusal(node("io { key: \"voltage\" value: \"1\" }")).what(),
               HasSubstr("node[0].io[0].key: \"voltage\" is not a signal name (CHANNEL.quantity"));
   EXPECT_THAT(
-      Refusal(node("io { key: \"DIN1.level\" value: \"high\" }\nio { key: \"DIN1.level\" value: \"low\" }"))
+      Refusal(node("io { key: \"IN1.level\" value: \"high\" }\nio { key: \"IN1.level\" value: \"low\" }"))
           .what(),
-      HasSubstr(":4:6: node[0].io[1].key: \"DIN1.level\" is already set by io[0]"));
+      HasSubstr(":4:6: node[0].io[1].key: \"IN1.level\" is already set by io[0]"));
 }
 
 TEST(TopologyIoTest, AGenericNodeHasNoSimulatedIo) {
   const TopologyError e = Refusal(R"(name: "t" bus { name: "can0" }
 node { name: "dio" eds: "eds/canfleet-dio16.eds" node_id: 9 bus: "can0"
-  io { key: "DIN1.level" value: "high" } }
+  io { key: "IN1.level" value: "high" } }
 )");
   EXPECT_THAT(
       e.what(),
@@ -409,9 +409,9 @@ TEST(TopologyScenarioTest, StepsReferToNodesAndBusesOfTheTopology) {
   EXPECT_THAT(Refusal(kTwoQuads + "scenario { at_ms: 5 }").what(),
               HasSubstr("scenario[0]: a step needs an action"));
   EXPECT_THAT(
-      Refusal(kTwoQuads + "scenario { io { node: \"quad-5\" name: \"AIN1.voltage_mV\" value: \"99999\" } }")
+      Refusal(kTwoQuads + "scenario { io { node: \"quad-5\" name: \"IN1.voltage_mV\" value: \"99999\" } }")
           .what(),
-      HasSubstr("scenario[0].io.value: AIN1.voltage_mV: 99999 is out of range"));
+      HasSubstr("scenario[0].io.value: IN1.voltage_mV: 99999 is out of range"));
   EXPECT_THAT(Refusal(kTwoQuads + "scenario { nmt { node: \"quad-5\" } }").what(),
               HasSubstr("scenario[0].nmt.action: required"));
   EXPECT_THAT(Refusal(kTwoQuads + "scenario { nmt { action: NMT_START node: \"x\" } }").what(),

@@ -111,11 +111,11 @@ TEST_F(ValveAoTest, FaultOverOverrideOverEnableOverControl) {
   Rpdo1(900);
   Advance(2ms);
   EXPECT_EQ(Fv(1), 0);  // DI2 OFF: disabled
-  SetEnum("DI2.level", "high");
+  SetEnum("IN9.level", "high");
   Advance(2ms);
   EXPECT_EQ(Fv(1), 900);  // enabled: the control
-  SetEnum("DI1.level", "high");
-  SetEnum("DI2.level", "low");
+  SetEnum("IN8.level", "high");
+  SetEnum("IN9.level", "low");
   Advance(2ms);
   EXPECT_EQ(Fv(1), 750);  // override (2300h) while disabled
   // Control from UI1 (7120h..7122h = 500..4500 mV) and UI1 out of span at once (2112h = 0).
@@ -124,12 +124,12 @@ TEST_F(ValveAoTest, FaultOverOverrideOverEnableOverControl) {
   Write(0x2340, 1, 2, 1);
   Write(0x2341, 1, 1, 1);
   Write(0x2112, 1, 0, 2);
-  SetNumber("UI1.voltage_mV", 100);
+  SetNumber("IN1.voltage_mV", 100);
   Advance(2ms);
   EXPECT_EQ(Fv(1), 500);  // 7341h
-  SetNumber("UI1.voltage_mV", 2500);
-  SetEnum("DI1.level", "low");
-  SetEnum("DI2.level", "high");
+  SetNumber("IN1.voltage_mV", 2500);
+  SetEnum("IN8.level", "low");
+  SetEnum("IN9.level", "high");
   Advance(2ms);
   EXPECT_EQ(Fv(1), 900);  // 300 + 2000 x 1200 / 4000
 }
@@ -143,10 +143,10 @@ TEST_F(ValveAoTest, FaultModeHoldsTheLastValue) {
   Write(0x2341, 1, 1, 1);
   Write(0x2112, 1, 0, 2);
   Write(0x6340, 1, 0, 1);
-  SetNumber("UI1.voltage_mV", 3500);
+  SetNumber("IN1.voltage_mV", 3500);
   Advance(2ms);
   EXPECT_EQ(Fv(1), 1200);
-  SetNumber("UI1.voltage_mV", 6000);  // above 7149h: faulted
+  SetNumber("IN1.voltage_mV", 6000);  // above 7149h: faulted
   Advance(2ms);
   EXPECT_EQ(Fv(1), 1200);
 }
@@ -156,12 +156,12 @@ TEST_F(ValveAoTest, EnableRampOffAndKeepLast) {
   Write(0x2350, 2, 2, 1);
   Write(0x2351, 2, 8, 1);  // DI1
   Write(0x2352, 2, 1, 1);
-  SetEnum("DI1.level", "high");
+  SetEnum("IN8.level", "high");
   Operational();
   Rpdo1(0, 1500);
   Advance(1300ms);
   EXPECT_EQ(Fv(2), 1500);
-  SetEnum("DI1.level", "low");
+  SetEnum("IN8.level", "low");
   Advance(501ms);
   EXPECT_NEAR(static_cast<double>(Fv(2)), 900, 2);  // ramping down to 0 at 1.2 mA/ms
   Write(0x2352, 2, 2, 1);
@@ -321,7 +321,7 @@ TEST_F(ValveAoTest, OverrideWhenOff) {
   Rpdo1(900);
   Advance(2ms);
   EXPECT_EQ(Fv(1), 1200);
-  SetEnum("DI5.level", "high");
+  SetEnum("IN12.level", "high");
   Advance(2ms);
   EXPECT_EQ(Fv(1), 900);
 }

@@ -83,7 +83,7 @@ TEST_F(ValveCommTest, ErrorHistoryKeepsFour) {
   for (std::uint8_t sub = 1; sub <= 5; ++sub)
     Write(0x2112, sub, 0, 2);
   for (int n = 1; n <= 5; ++n)
-    SetNumber("UI" + std::to_string(n) + ".voltage_mV", 0);
+    SetNumber("IN" + std::to_string(n) + ".voltage_mV", 0);
   Advance(2ms);
   EXPECT_EQ(Read(0x1003, 0), 4);
   EXPECT_EQ(Read(0x1003, 1), 0x4005F001);

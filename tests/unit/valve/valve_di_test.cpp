@@ -16,10 +16,10 @@ class ValveDiTest : public ValveTest {
 // Table 3, 0 (default): HIGH = ON, LOW or open = OFF. DI1 is sub-index 8.
 TEST_F(ValveDiTest, NormalPolarity) {
   EXPECT_EQ(Read(0x6020, 8), 0);
-  Level("DI1.level", "high");
+  Level("IN8.level", "high");
   EXPECT_EQ(Read(0x6020, 8), 1);
   EXPECT_EQ(Read(0x7100, 8), 1);  // Table 10's digital row: the FV is the state
-  Level("DI1.level", "low");
+  Level("IN8.level", "low");
   EXPECT_EQ(Read(0x6020, 8), 0);
 }
 
@@ -28,7 +28,7 @@ TEST_F(ValveDiTest, InversePolarity) {
   Write(0x2010, 9, 1, 1);
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 9), 1);  // DI2 open
-  Level("DI2.level", "high");
+  Level("IN9.level", "high");
   EXPECT_EQ(Read(0x6020, 9), 0);
 }
 
@@ -47,18 +47,18 @@ TEST_F(ValveDiTest, LatchedPolarity) {
   Write(0x2010, 11, 2, 1);
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 11), 0);
-  Level("DI4.level", "high");
+  Level("IN11.level", "high");
   EXPECT_EQ(Read(0x6020, 11), 1);
-  Level("DI4.level", "low");
+  Level("IN11.level", "low");
   EXPECT_EQ(Read(0x6020, 11), 1);
-  Level("DI4.level", "high");
+  Level("IN11.level", "high");
   EXPECT_EQ(Read(0x6020, 11), 0);
 }
 
 // §1.2: a universal input set to 6112h = 10 reads its pin as a digital input too.
 TEST_F(ValveDiTest, UniversalInputAsDigital) {
   Write(0x6112, 3, 10, 1);
-  Level("UI3.level", "high");
+  Level("IN3.level", "high");
   EXPECT_EQ(Read(0x6020, 3), 1);
   EXPECT_EQ(Read(0x7100, 3), 1);
   EXPECT_EQ(Read(0x2102, 3), 0);  // Table 9: digital FV has no decimals (5550h cascade)
@@ -66,7 +66,7 @@ TEST_F(ValveDiTest, UniversalInputAsDigital) {
 
 // Table 4, 0: a channel off reads 0 whatever its pin.
 TEST_F(ValveDiTest, ChannelOff) {
-  Level("DI5.level", "high");
+  Level("IN12.level", "high");
   EXPECT_EQ(Read(0x6020, 12), 1);
   Write(0x6112, 12, 0, 1);
   Advance(2ms);

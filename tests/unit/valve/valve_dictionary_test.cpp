@@ -61,7 +61,7 @@ TEST_F(ValveDictionaryTest, SteadyNodeSleepsAndWakesOnInputChanges) {
   const auto runs = valve().Runs();
   Advance(10s);
   EXPECT_EQ(valve().Runs(), runs);
-  SetNumber("UI1.voltage_mV", 3000);
+  SetNumber("IN1.voltage_mV", 3000);
   EXPECT_FALSE(valve().Idle());
   Advance(5ms);
   EXPECT_EQ(Read(0x7100, 1, true), 3000);
@@ -100,7 +100,7 @@ TEST_F(ValveDictionaryTest, TpdosAndDisabledInputs) {
 // §3.2.4 / reset node: the node boots without errors and its blocks start over; a condition still
 // present is found again after its delay.
 TEST_F(ValveDictionaryTest, ResetNodeStartsOver) {
-  SetNumber("UI2.voltage_mV", 0);
+  SetNumber("IN2.voltage_mV", 0);
   Advance(1100ms);
   EXPECT_EQ(Read(0x1003, 0), 1);
   Send("000#8105");

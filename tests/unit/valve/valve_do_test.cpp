@@ -22,27 +22,27 @@ class ValveDoTest : public ValveTest {
 TEST_F(ValveDoTest, RpdoSwitchesTheOutput) {
   Rpdo4(0, 0x01);
   Advance(2ms);
-  EXPECT_TRUE(On("DO1"));
-  EXPECT_FALSE(On("DO2"));
+  EXPECT_TRUE(On("OUT9"));
+  EXPECT_FALSE(On("OUT10"));
   EXPECT_EQ(Read(0x7330, 9), 1);
-  EXPECT_EQ(Out("DO1.current_mA"), 1000);
+  EXPECT_EQ(Out("OUT9.current_mA"), 1000);
   Advance(200ms);
   EXPECT_EQ(Read(0x2370, 9), 1);  // §1.4: 2370h carries the drive state
   Rpdo4(0, 0x0A);
   Advance(2ms);
-  EXPECT_FALSE(On("DO1"));
-  EXPECT_TRUE(On("DO2"));
-  EXPECT_TRUE(On("DO4"));
+  EXPECT_FALSE(On("OUT9"));
+  EXPECT_TRUE(On("OUT10"));
+  EXPECT_TRUE(On("OUT12"));
 }
 
 // Table 12, 1 "inverse".
 TEST_F(ValveDoTest, InversePolarity) {
   Write(0x2210, 10, 1, 1);
   Advance(2ms);
-  EXPECT_TRUE(On("DO2"));
+  EXPECT_TRUE(On("OUT10"));
   Rpdo4(0, 0x02);
   Advance(2ms);
-  EXPECT_FALSE(On("DO2"));
+  EXPECT_FALSE(On("OUT10"));
 }
 
 // Table 12, 2 "latched": OFF -> ON of the logic state toggles the drive; ON -> OFF changes nothing.
@@ -50,13 +50,13 @@ TEST_F(ValveDoTest, LatchedPolarity) {
   Write(0x2210, 11, 2, 1);
   Rpdo4(0, 0x04);
   Advance(2ms);
-  EXPECT_TRUE(On("DO3"));
+  EXPECT_TRUE(On("OUT11"));
   Rpdo4(0, 0);
   Advance(2ms);
-  EXPECT_TRUE(On("DO3"));
+  EXPECT_TRUE(On("OUT11"));
   Rpdo4(0, 0x04);
   Advance(2ms);
-  EXPECT_FALSE(On("DO3"));
+  EXPECT_FALSE(On("OUT11"));
 }
 
 // Table 12, 3 and §3.4.23: while ON, on for 2223h ms then off for 2223h ms; the node wakes at each
@@ -66,17 +66,17 @@ TEST_F(ValveDoTest, BlinkAt2223h) {
   Write(0x2223, 12, 500, 2);
   Rpdo4(0, 0x08);
   Advance(250ms);  // the logic turned ON at +1 ms
-  EXPECT_TRUE(On("DO4"));
+  EXPECT_TRUE(On("OUT12"));
   Advance(500ms);
-  EXPECT_FALSE(On("DO4"));
+  EXPECT_FALSE(On("OUT12"));
   Advance(500ms);
-  EXPECT_TRUE(On("DO4"));
+  EXPECT_TRUE(On("OUT12"));
   const auto runs = valve().Runs();
   Advance(2000ms);
   EXPECT_LE(valve().Runs() - runs, 60u);  // toggles and feedback windows, not 2000 ticks
   Rpdo4(0, 0);
   Advance(2ms);
-  EXPECT_FALSE(On("DO4"));
+  EXPECT_FALSE(On("OUT12"));
 }
 
 // §3.4.24/3.4.25: with 2225h = 1 (ON) the ON edge waits 2224h ms, the OFF edge acts at once;
@@ -85,21 +85,21 @@ TEST_F(ValveDoTest, DelayOnTheEdgeOf2225h) {
   Write(0x2224, 9, 300, 2);
   Rpdo4(0, 0x01);
   Advance(300ms);
-  EXPECT_FALSE(On("DO1"));
+  EXPECT_FALSE(On("OUT9"));
   Advance(2ms);
-  EXPECT_TRUE(On("DO1"));
+  EXPECT_TRUE(On("OUT9"));
   Rpdo4(0, 0);
   Advance(2ms);
-  EXPECT_FALSE(On("DO1"));
+  EXPECT_FALSE(On("OUT9"));
   Write(0x2225, 9, 0, 1);
   Rpdo4(0, 0x01);
   Advance(2ms);
-  EXPECT_TRUE(On("DO1"));
+  EXPECT_TRUE(On("OUT9"));
   Rpdo4(0, 0);
   Advance(200ms);
-  EXPECT_TRUE(On("DO1"));
+  EXPECT_TRUE(On("OUT9"));
   Advance(102ms);
-  EXPECT_FALSE(On("DO1"));
+  EXPECT_FALSE(On("OUT9"));
 }
 
 // §1.4 Figure 9, §3.4.20-3.4.22: a hotshot output drives 2220h for 2222h ms, then holds 2221h.
@@ -135,26 +135,26 @@ TEST_F(ValveDoTest, FaultStateOnAFaultedInput) {
   Write(0x2112, 1, 0, 2);
   Write(0x6260, 10, 0, 1);
   Advance(2ms);
-  EXPECT_TRUE(On("DO2"));  // 2500 mV
-  SetNumber("UI1.voltage_mV", 100);
+  EXPECT_TRUE(On("OUT10"));  // 2500 mV
+  SetNumber("IN1.voltage_mV", 100);
   Advance(2ms);
-  EXPECT_FALSE(On("DO2"));  // 6260h = OFF
+  EXPECT_FALSE(On("OUT10"));  // 6260h = OFF
   Write(0x6260, 10, 1, 1);
   Advance(2ms);
-  EXPECT_TRUE(On("DO2"));
+  EXPECT_TRUE(On("OUT10"));
   Write(0x6250, 10, 0, 1);
-  SetNumber("UI1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Advance(2ms);
   Rpdo4(0, 0);
   Write(0x2340, 10, 1, 1);  // back to the RPDO, which says OFF
   Write(0x2341, 10, 10, 1);
   Advance(2ms);
-  EXPECT_FALSE(On("DO2"));
+  EXPECT_FALSE(On("OUT10"));
   Write(0x2340, 10, 2, 1);
   Write(0x2341, 10, 1, 1);
-  SetNumber("UI1.voltage_mV", 100);
+  SetNumber("IN1.voltage_mV", 100);
   Advance(2ms);
-  EXPECT_FALSE(On("DO2"));  // maintained
+  EXPECT_FALSE(On("OUT10"));  // maintained
 }
 
 // §1.4: DO1-DO4 can only be 1000 or 0 (disabled).
@@ -162,7 +162,7 @@ TEST_F(ValveDoTest, DisabledOutputStaysOff) {
   Write(0x6310, 9, 0, 2);
   Rpdo4(0, 0x01);
   Advance(2ms);
-  EXPECT_FALSE(On("DO1"));
+  EXPECT_FALSE(On("OUT9"));
 }
 
 }  // namespace

@@ -132,16 +132,16 @@ TEST_F(ValveInputTest, Table11FloorsForCurrentAndResistance) {
 // §1.3 / Table 9: each type reads its pin in its unit: mA, 0.01 kOhm, Hz, 0.1 RPM, 0.1 %.
 TEST_F(ValveInputTest, MeasuresEachSensorType) {
   Write(0x6110, 2, 50, 2);
-  SetNumber("UI2.current_uA", 12400);
+  SetNumber("IN2.current_mA", 12.4);
   Write(0x6110, 3, 11000, 2);
-  SetNumber("UI3.resistance_ohm", 4700);
+  SetNumber("IN3.resistance_ohm", 4700);
   Write(0x6110, 5, 60, 2);
-  SetNumber("UI5.frequency_Hz", 1500);
+  SetNumber("IN5.frequency_Hz", 1500);
   Write(0x6110, 7, 10000, 2);
-  SetNumber("UI7.duty_pct", 37.5);
+  SetNumber("IN7.duty_pct", 37.5);
   Write(0x6110, 1, 60, 2);
   Write(0x2101, 1, 4, 2);
-  SetNumber("UI1.frequency_Hz", 200);  // 200 Hz x 60 / 4 = 3000 RPM
+  SetNumber("IN1.frequency_Hz", 200);  // 200 Hz x 60 / 4 = 3000 RPM
   Advance(2ms);
   EXPECT_EQ(Read(0x7100, 2, true), 12);
   EXPECT_EQ(Read(0x7100, 3, true), 470);
@@ -154,7 +154,7 @@ TEST_F(ValveInputTest, MeasuresEachSensorType) {
 TEST_F(ValveInputTest, ProcessValueScaling) {
   Write(0x7121, 1, 0, 2);
   Write(0x7123, 1, 1000, 2);  // 0.5..4.5 V -> 0..1000
-  SetNumber("UI1.voltage_mV", 2500);
+  SetNumber("IN1.voltage_mV", 2500);
   Advance(2ms);
   EXPECT_EQ(Read(0x7130, 1, true), 500);
 }
@@ -163,7 +163,7 @@ TEST_F(ValveInputTest, ProcessValueScaling) {
 TEST_F(ValveInputTest, MovingAverageFilter) {
   Write(0x61A0, 1, 1, 1);
   Advance(2ms);
-  SetNumber("UI1.voltage_mV", 3500);
+  SetNumber("IN1.voltage_mV", 3500);
   Advance(1ms);
   EXPECT_EQ(Read(0x7100, 1, true), 2600);
   Advance(1ms);
@@ -177,7 +177,7 @@ TEST_F(ValveInputTest, MovingAverageFilter) {
 TEST_F(ValveInputTest, RepeatingAverageFilter) {
   Write(0x61A0, 1, 2, 1);
   Advance(20ms);
-  SetNumber("UI1.voltage_mV", 3500);
+  SetNumber("IN1.voltage_mV", 3500);
   Advance(9ms);
   const auto before = Read(0x7100, 1, true);
   EXPECT_TRUE(before == 2500 || (before > 2500 && before < 3500)) << before;
@@ -188,7 +188,7 @@ TEST_F(ValveInputTest, RepeatingAverageFilter) {
 // §1.3 Table 8, 3, §3.4.11-3.4.18: the default second-order low pass (N0-N2 120/241/120, O1/O2
 // 704/-164, >> 10) called every 61A1h = 10 ms; its DC gain 481/484 leaves a settled FV 0.6 % low.
 TEST_F(ValveInputTest, ThirdOrderFilterDefaultCoefficients) {
-  SetNumber("UI1.voltage_mV", 3500);
+  SetNumber("IN1.voltage_mV", 3500);
   Advance(2ms);
   Write(0x2110, 1, 0, 1);  // the filter starts from 0: keep the span check out of it
   Write(0x61A0, 1, 3, 1);
@@ -201,7 +201,7 @@ TEST_F(ValveInputTest, ThirdOrderFilterDefaultCoefficients) {
 
 // §1.3: below 7148h for 2112h -> 4001F001h, EMCY F001h; the flag clears only at 7148h + 2111h.
 TEST_F(ValveInputTest, SpanLowFaultWithDelayAndHysteresis) {
-  SetNumber("UI1.voltage_mV", 100);
+  SetNumber("IN1.voltage_mV", 100);
   Advance(1000ms);
   EXPECT_TRUE(Frames("085#").empty());
   Advance(1ms);
@@ -209,11 +209,11 @@ TEST_F(ValveInputTest, SpanLowFaultWithDelayAndHysteresis) {
   EXPECT_EQ(Read(0x1003, 0), 1);
   EXPECT_EQ(Entry(1), 0x4001F001u);
   EXPECT_EQ(Read(0x1001, 0), 1);
-  SetNumber("UI1.voltage_mV", 250);  // back above 7148h but below 7148h + 2111h = 300
+  SetNumber("IN1.voltage_mV", 250);  // back above 7148h but below 7148h + 2111h = 300
   Advance(10ms);
   EXPECT_TRUE(Frames("085#").empty());
   EXPECT_EQ(Read(0x1003, 0), 1);
-  SetNumber("UI1.voltage_mV", 300);
+  SetNumber("IN1.voltage_mV", 300);
   Advance(2ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{EmcyReset()});
   EXPECT_EQ(Read(0x1003, 0), 0);
@@ -223,23 +223,23 @@ TEST_F(ValveInputTest, SpanLowFaultWithDelayAndHysteresis) {
 // §1.3: above 7149h -> 20nnF001h; it clears at 7149h - 2111h.
 TEST_F(ValveInputTest, SpanHighFault) {
   Write(0x2112, 3, 200, 2);
-  SetNumber("UI3.voltage_mV", 4900);
+  SetNumber("IN3.voltage_mV", 4900);
   Advance(201ms);
   EXPECT_EQ(Frames("085#"), std::vector<std::string>{Emcy(0xF001, 0x01, 3, 0x20)});
   EXPECT_EQ(Entry(1), 0x2003F001u);
-  SetNumber("UI3.voltage_mV", 4750);  // inside the span, not yet 7149h - 2111h = 4700
+  SetNumber("IN3.voltage_mV", 4750);  // inside the span, not yet 7149h - 2111h = 4700
   Advance(10ms);
   EXPECT_EQ(Read(0x1003, 0), 1);
-  SetNumber("UI3.voltage_mV", 4700);
+  SetNumber("IN3.voltage_mV", 4700);
   Advance(2ms);
   EXPECT_EQ(Read(0x1003, 0), 0);
 }
 
 // §3.4.10: a flag that goes away during 2112h is never reported.
 TEST_F(ValveInputTest, SpanFlagShorterThanTheDelayIsNotReported) {
-  SetNumber("UI2.voltage_mV", 50);
+  SetNumber("IN2.voltage_mV", 50);
   Advance(600ms);
-  SetNumber("UI2.voltage_mV", 2500);
+  SetNumber("IN2.voltage_mV", 2500);
   Advance(2s);
   EXPECT_TRUE(Frames("085#").empty());
 }
@@ -248,9 +248,9 @@ TEST_F(ValveInputTest, SpanFlagShorterThanTheDelayIsNotReported) {
 // clears the other."
 TEST_F(ValveInputTest, LowFlagReplacedByHighFlag) {
   Write(0x2112, 1, 0, 2);
-  SetNumber("UI1.voltage_mV", 100);
+  SetNumber("IN1.voltage_mV", 100);
   Advance(2ms);
-  SetNumber("UI1.voltage_mV", 5000);
+  SetNumber("IN1.voltage_mV", 5000);
   Advance(2ms);
   EXPECT_EQ(Frames("085#"), (std::vector<std::string>{Emcy(0xF001, 0x01, 1, 0x40), EmcyReset(),
                                                       Emcy(0xF001, 0x01, 1, 0x20)}));
@@ -261,7 +261,7 @@ TEST_F(ValveInputTest, LowFlagReplacedByHighFlag) {
 // §3.4.8: with 2110h FALSE nothing is reported.
 TEST_F(ValveInputTest, ErrorDetectionDisabled) {
   Write(0x2110, 1, 0, 1);
-  SetNumber("UI1.voltage_mV", 0);
+  SetNumber("IN1.voltage_mV", 0);
   Advance(3s);
   EXPECT_TRUE(Frames("085#").empty());
 }
@@ -271,7 +271,7 @@ TEST_F(ValveInputTest, InputFaultAppliesErrorBehaviourSub3) {
   Write(0x1029, 3, 2, 1);
   Start();
   Write(0x2112, 4, 0, 2);
-  SetNumber("UI4.voltage_mV", 0);
+  SetNumber("IN4.voltage_mV", 0);
   Advance(2ms);
   EXPECT_EQ(stack().State(), canopen::NmtState::kStopped);
 }
@@ -280,7 +280,7 @@ TEST_F(ValveInputTest, InputFaultAppliesErrorBehaviourSub3) {
 TEST_F(ValveInputTest, DigitalInputsHaveNoEmcy) {
   Write(0x6112, 8, 1, 1);  // DI1 as PWM (6110h 10000): Table 10 PWM row, span 10..990 (0.1 %)
   Write(0x2112, 8, 0, 2);
-  SetNumber("DI1.duty_pct", 0);
+  SetNumber("IN8.duty_pct", 0);
   Advance(10ms);
   EXPECT_TRUE(Frames("085#").empty());
 }
@@ -291,20 +291,20 @@ TEST_F(ValveInputTest, AnalogOnOffMode) {
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 1), 0);
   EXPECT_EQ(Read(0x7100, 1, true), 2500);
-  SetNumber("UI1.voltage_mV", 4500);
+  SetNumber("IN1.voltage_mV", 4500);
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 1), 1);
-  SetNumber("UI1.voltage_mV", 2000);
+  SetNumber("IN1.voltage_mV", 2000);
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 1), 1);  // held between the thresholds
-  SetNumber("UI1.voltage_mV", 500);
+  SetNumber("IN1.voltage_mV", 500);
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 1), 0);
 }
 
 // §1.2: "For all other operating modes, object 6020h will always be zero."
 TEST_F(ValveInputTest, NormalModeLeavesReadStateZero) {
-  SetEnum("UI1.level", "high");
+  SetEnum("IN1.level", "high");
   Advance(2ms);
   EXPECT_EQ(Read(0x6020, 1), 0);
 }

@@ -12,7 +12,7 @@ constexpr std::uint32_t kTooLow = 0x06090032;
 class ValveMonitorTest : public ValveTest {
  protected:
   void Supply(double volts) {
-    SetNumber("VPS.voltage_V", volts);
+    SetNumber("VPS.voltage_mV", volts * 1000);
     Advance(2ms);
   }
 };

@@ -48,13 +48,13 @@ Bytes MixedStream() {
   w.AddPong(43);
   NodeRequest request;
   request.set_request_id(7);
-  request.mutable_io_set()->set_name("AIN1.voltage_mV");
+  request.mutable_io_set()->set_name("IN1.voltage_mV");
   request.mutable_io_set()->set_value("3000");
   w.AddNodeRequest(request);
   NodeReply node_reply;
   node_reply.set_request_id(7);
   IoValue& value = *node_reply.add_values();
-  value.set_name("AIN1.voltage_mV");
+  value.set_name("IN1.voltage_mV");
   value.set_value("3000");
   value.set_unit("mV");
   value.set_input(true);
@@ -81,8 +81,8 @@ const std::vector<std::string> kMixedExpected = {
     "FrameBatch 181#AA@6000",
     "Ping 42",
     "Pong 43",
-    R"(NodeRequest request_id: 7 io_set { name: "AIN1.voltage_mV" value: "3000" })",
-    R"(NodeReply request_id: 7 values { name: "AIN1.voltage_mV" value: "3000" unit: "mV" input: true })",
+    R"(NodeRequest request_id: 7 io_set { name: "IN1.voltage_mV" value: "3000" })",
+    R"(NodeReply request_id: 7 values { name: "IN1.voltage_mV" value: "3000" unit: "mV" input: true })",
     "FrameBatch 182#BB@7000",
     "BitRate 250000",
     "TimeGrant 7000..7024",
