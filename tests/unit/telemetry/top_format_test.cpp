@@ -199,7 +199,7 @@ class NodeDetail : public TopFormat {
     IoSnapshotSample io{.bus = "can0", .node_id = 6};
     io.inputs = {{"IN1.voltage_mV", 1200, "mV"}, {"IN1.level", 1, ""}};
     io.outputs = {
-        {"OUT1.current_mA", 0, "mA"}, {"VPS.voltage_mV", 4750, "mV"}, {"OUT2.current_mA", 800, "mA"}};
+        {"OUT1.current_mA", 0, "mA"}, {"TEMP.temperature_C", 41.25, "C"}, {"OUT2.current_mA", 800, "mA"}};
     view_.Apply(io, At(kNow - 400ms), nullptr);
     view_.Apply(EmcySample{.bus = "can0",
                            .node_id = 6,
@@ -226,7 +226,7 @@ TEST_F(NodeDetail, ShowsStatusCountersIoWithUnitsAndTheEmcysTheBusSawNewestFirst
   EXPECT_NE(ain->find("1200 mV"), std::string::npos);
   EXPECT_NE(ain->find("OUT1.current_mA"), std::string::npos);  // outputs beside the inputs
   EXPECT_NE(ain->find("0 mA"), std::string::npos);
-  EXPECT_NE(frame.find("4.75 V"), std::string::npos);
+  EXPECT_NE(frame.find("41.25 C"), std::string::npos);
   EXPECT_NE(frame.find("AS THE BUS SAW THEM"), std::string::npos);
   const auto heartbeat = frame.find("8130h  01h  05 08 00 00 00  ");
   const auto reset = frame.find("0000h  00h  00 00 00 00 00  ");
