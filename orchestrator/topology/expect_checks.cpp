@@ -6,6 +6,7 @@
 #include <set>
 
 #include "orchestrator/control/sdo_value.hpp"
+#include "orchestrator/topology/port_numbering.hpp"
 
 namespace canfleet::topology::detail {
 
@@ -33,13 +34,13 @@ void CheckHexBytes(const Scope& s, std::string_view field, const std::string& te
                       " expected");
 }
 
+// `port` is 0-based; a port the node lacks is reported at port_field ("can", or the deprecated "port").
 const NodeFacts& RequirePort(const Scope& s, const TopologyFacts& facts, const std::string& node,
-                             std::uint32_t port) {
+                             std::uint32_t port, const char* port_field = "port") {
   if (node.empty()) s.Fail("node", "required: the node this expectation is about");
   const NodeFacts& n = facts.RequireNode(s, "node", node);
   if (port >= n.ports)
-    s.Fail("port", "port " + std::to_string(port) + " does not exist: " + n.name + " has " +
-                       PortsText(n.ports) + " (0-based)");
+    s.Fail(port_field, CanName(port) + " does not exist: " + n.name + " has " + PortsText(n.ports));
   return n;
 }
 
@@ -62,7 +63,7 @@ void CheckState(const Scope& s, const std::string& state, const std::set<std::st
 }
 
 void CheckSdoExpect(const Scope& s, const TopologyFacts& facts, const SdoExpect& e) {
-  const NodeFacts& node = RequirePort(s, facts, e.node(), e.port());
+  const NodeFacts& node = RequirePort(s, facts, e.node(), e.port(), PortFieldName(e));
   if (e.index() < 1 || e.index() > 0xFFFF)
     s.Fail("index", std::to_string(e.index()) + " is not an object index (1..0xFFFF)");
   if (e.subindex() > 255) s.Fail("subindex", std::to_string(e.subindex()) + " is not a sub-index (0..255)");
@@ -152,7 +153,7 @@ void CheckExpect(const Scope& s, const TopologyFacts& facts, const Expect& expec
     case E::kEmcy: {
       const Scope es = s.Child("emcy", expect.emcy());
       const EmcyExpect& e = expect.emcy();
-      RequirePort(es, facts, e.node(), e.port());
+      RequirePort(es, facts, e.node(), e.port(), PortFieldName(e));
       if (!e.has_code()) es.Fail("code", "required: the error code (e.g. 0x8130; 0 is the error reset)");
       if (e.code() > 0xFFFF) es.Fail("code", Hex(e.code()) + " is not an EMCY error code (16 bits)");
       if (e.has_error_register() && e.error_register() > 0xFF)
@@ -167,15 +168,15 @@ void CheckExpect(const Scope& s, const TopologyFacts& facts, const Expect& expec
     case E::kNoEmcy: {
       const Scope es = s.Child("no_emcy", expect.no_emcy());
       const NoEmcyExpect& e = expect.no_emcy();
-      if (!e.node().empty()) RequirePort(es, facts, e.node(), e.port());
-      if (e.node().empty() && e.port() != 0) es.Fail("port", "a port needs a node");
+      if (!e.node().empty()) RequirePort(es, facts, e.node(), e.port(), PortFieldName(e));
+      if (e.node().empty() && e.port() != 0) es.Fail(PortFieldName(e), "a port needs a node");
       if (e.has_code() && e.code() > 0xFFFF)
         es.Fail("code", Hex(e.code()) + " is not an EMCY error code (16 bits)");
       break;
     }
     case E::kNmt: {
       const Scope ns = s.Child("nmt", expect.nmt());
-      RequirePort(ns, facts, expect.nmt().node(), expect.nmt().port());
+      RequirePort(ns, facts, expect.nmt().node(), expect.nmt().port(), PortFieldName(expect.nmt()));
       CheckState(ns, expect.nmt().state(), {"operational", "pre-operational", "stopped"});
       break;
     }
@@ -203,7 +204,8 @@ void CheckExpect(const Scope& s, const TopologyFacts& facts, const Expect& expec
     }
     case E::kController: {
       const Scope cs = s.Child("controller", expect.controller());
-      RequirePort(cs, facts, expect.controller().node(), expect.controller().port());
+      RequirePort(cs, facts, expect.controller().node(), expect.controller().port(),
+                  PortFieldName(expect.controller()));
       CheckState(cs, expect.controller().state(), {"bus-off", "error-active", "error-passive"});
       break;
     }

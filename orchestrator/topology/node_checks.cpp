@@ -12,6 +12,7 @@
 #include "node/canopen/eds/eds_reader.hpp"
 #include "node/devices/eds_dictionary.hpp"
 #include "orchestrator/control/sdo_value.hpp"
+#include "orchestrator/topology/port_numbering.hpp"
 #include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::topology::detail {
@@ -39,7 +40,7 @@ void CheckNodeIds(const Scope& s, const Node& node, NodeFacts& facts) {
     s.FailHere("node " + node.name() + " needs node_id (1..127, or 255 for an LSS slave)");
   if (node.node_id_size() != 1 && static_cast<std::size_t>(node.node_id_size()) != facts.ports)
     s.Fail("node_id", 0,
-           "give one node-ID, or one per port (" + PortsText(facts.ports) + "); " +
+           "give one node-ID, or one per port (" + facts.kind + " has " + PortsText(facts.ports) + "); " +
                std::to_string(node.node_id_size()) + " given");
   for (int k = 0; k < node.node_id_size(); ++k) {
     const std::uint32_t id = node.node_id(k);
@@ -146,7 +147,7 @@ void NodeChecks::CheckNodes(const Scope& root) {
     for (int k = 0; k < node.sdo_size(); ++k) {
       const SdoWrite& w = node.sdo(k);
       const Scope ws = s.Child("sdo", w, k);
-      CheckSdo(ws, facts, w.index(), w.subindex(), w.type(), w.value(), w.port());
+      CheckSdo(ws, facts, w.index(), w.subindex(), w.type(), w.value(), w.port(), PortFieldName(w));
     }
     if (node.heartbeat().producer_ms() > 0xFFFF)
       s.Child("heartbeat", node.heartbeat())
@@ -350,7 +351,8 @@ devices::IoName ResolveSignal(const Scope& s, std::string_view name_field, const
 }
 
 void CheckSdo(const Scope& s, const NodeFacts& facts, std::uint32_t index, std::uint32_t subindex,
-              const std::string& type_name, const std::string& value, std::uint32_t port) {
+              const std::string& type_name, const std::string& value, std::uint32_t port,
+              const char* port_field) {
   if (index < 1 || index > 0xFFFF)
     s.Fail("index", std::to_string(index) + " is not an object index (1..0xFFFF)");
   if (subindex > 255) s.Fail("subindex", std::to_string(subindex) + " is not a sub-index (0..255)");
@@ -366,8 +368,7 @@ void CheckSdo(const Scope& s, const NodeFacts& facts, std::uint32_t index, std::
   }
   const std::size_t type_size = control::SdoTypeSize(*type);
   if (port >= facts.ports)
-    s.Fail("port", "port " + std::to_string(port) + " does not exist: " + facts.name + " has " +
-                       PortsText(facts.ports) + " (0-based)");
+    s.Fail(port_field, CanName(port) + " does not exist: " + facts.name + " has " + PortsText(facts.ports));
   const canopen::ObjectDictionary& od = facts.dictionaries->at(port);
   const auto idx = static_cast<std::uint16_t>(index);
   const auto sub = static_cast<std::uint8_t>(subindex);

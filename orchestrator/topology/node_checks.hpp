@@ -50,8 +50,10 @@ void CheckIoSet(const Scope& s, std::string_view name_field, std::string_view va
                 const NodeFacts& facts, const std::string& name, const std::string& value);
 
 /// An SDO write to the node (node sdo lists and scenario sdo steps): the request is well-formed
-/// and the node's dictionary has a writable object of that size there.
+/// and the node's dictionary has a writable object of that size there. `port` is 0-based; a port
+/// the node lacks is reported at `port_field` (PortFieldName: "can" or the deprecated "port").
 void CheckSdo(const Scope& s, const NodeFacts& facts, std::uint32_t index, std::uint32_t subindex,
-              const std::string& type_name, const std::string& value, std::uint32_t port);
+              const std::string& type_name, const std::string& value, std::uint32_t port,
+              const char* port_field);
 
 }  // namespace canfleet::topology::detail

@@ -7,6 +7,7 @@
 #include "orchestrator/control/fault_kinds.hpp"
 #include "orchestrator/topology/expect_checks.hpp"
 #include "orchestrator/topology/node_checks.hpp"
+#include "orchestrator/topology/port_numbering.hpp"
 
 namespace canfleet::topology::detail {
 
@@ -70,7 +71,7 @@ void ScenarioChecks::CheckScenario(const Scope& root) {
         const control::SdoWrite& w = step.sdo();
         const Scope ws = s.Child("sdo", w);
         const NodeFacts& facts = facts_.RequireNode(ws, "node", w.node());
-        CheckSdo(ws, facts, w.index(), w.subindex(), w.type(), w.value(), w.port());
+        CheckSdo(ws, facts, w.index(), w.subindex(), w.type(), w.value(), w.port(), PortFieldName(w));
         break;
       }
       case Step::kExpect:

@@ -27,7 +27,10 @@ std::string Hex(std::uint32_t value) {
 }
 
 std::string PortsText(std::size_t ports) {
-  return std::to_string(ports) + (ports == 1 ? " CAN port" : " CAN ports");
+  std::string names;
+  for (std::size_t p = 1; p <= ports; ++p)
+    names += (p == 1 ? "CAN" : ", CAN") + std::to_string(p);
+  return std::to_string(ports) + (ports == 1 ? " CAN port (" : " CAN ports (") + names + ")";
 }
 
 std::string NameProblem(std::string_view name) {

@@ -17,6 +17,7 @@
 #include "orchestrator/control/fault_kinds.hpp"
 #include "orchestrator/topology/located_error.hpp"
 #include "orchestrator/topology/node_checks.hpp"
+#include "orchestrator/topology/port_numbering.hpp"
 #include "orchestrator/topology/scenario_checks.hpp"
 #include "orchestrator/topology/topology_facts.hpp"
 #include "orchestrator/topology/topology_warnings.hpp"
@@ -52,6 +53,7 @@ class Loader {
     Parse(text);
     std::vector<TopologyWarning> warnings;  // what the checks note on the way (an old signal name)
     const Scope root(&display_, &spec_, &tree_, "", Loc{1, 1}, &warnings);
+    NumberPortsAsManuals(root, spec_);  // before the checks: they read the 0-based port
     CheckTopology(root);
     CheckOrchestrator(root);
     CheckTime(root);

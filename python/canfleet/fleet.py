@@ -199,13 +199,14 @@ class Node:
 
     # -- SDO (the orchestrator is the client) --------------------------------------------------
     def sdo_read(self, index: int, subindex: int = 0, type: Optional[str] = None, *, block: bool = False,
-                 port: int = 0) -> SdoValue:
+                 can: int = 1) -> SdoValue:
         """Reads an object. `type` (cocomm's names: b i8 i16 i32 i64 u8 u16 u32 u64 r32 r64 vs os d)
         decodes it: int, float, bool, str (vs) or bytes (os, d); without a type: the raw bytes.
+        `can` is the CAN port as the manual prints it (2: the data logger's CAN2).
         Raises SdoAbortError (with .code) on an abort."""
         _check_sdo_type(type)
         request = pb.Request(sdo_read=pb.SdoRead(node=self.name, index=index, subindex=subindex,
-                                                 type=type or "", block=block, port=port))
+                                                 type=type or "", block=block, port=_wire_port(can)))
         data = self.fleet._call(request).sdo
         if type is None or type in ("os", "d"):
             return bytes(data.data)
@@ -218,8 +219,9 @@ class Node:
         return data.text
 
     def sdo_write(self, index: int, subindex: int, value: SdoValue, type: str, *, block: bool = False,
-                  port: int = 0) -> None:
-        """Writes an object as `type` (see sdo_read); bytes for os/d. Raises SdoAbortError on an abort."""
+                  can: int = 1) -> None:
+        """Writes an object as `type` (see sdo_read; `can` as there); bytes for os/d. Raises
+        SdoAbortError on an abort."""
         _check_sdo_type(type)
         if isinstance(value, (bytes, bytearray)):
             text = bytes(value).hex()
@@ -228,7 +230,8 @@ class Node:
         else:
             text = str(value)
         self.fleet._call(pb.Request(sdo_write=pb.SdoWrite(node=self.name, index=index, subindex=subindex,
-                                                          type=type, value=text, block=block, port=port)))
+                                                          type=type, value=text, block=block,
+                                                          port=_wire_port(can))))
 
     # -- NMT, faults ---------------------------------------------------------------------------
     def nmt(self, action: str) -> None:
@@ -241,6 +244,13 @@ class Node:
 
     def __repr__(self) -> str:
         return f"<Node {self.name}>"
+
+
+def _wire_port(can: int) -> int:
+    """The control API's 0-based port of CAN`can` (the manuals' CAN1, CAN2)."""
+    if can not in (1, 2):
+        raise ValueError(f"can={can!r}: CAN ports are numbered as the manuals print them, 1 (CAN1) or 2 (CAN2)")
+    return can - 1
 
 
 def _check_sdo_type(type: Optional[str]) -> None:

@@ -42,6 +42,16 @@ def test_sdo_write_read_back_and_abort_code(fleet: Fleet) -> None:
     assert "06020000" in str(e.value)
 
 
+def test_sdo_ports_are_numbered_as_the_manuals_print_them(fleet: Fleet) -> None:
+    quad5 = fleet.node("quad-5")
+    assert quad5.sdo_read(0x1017, 0, "u16", can=1) == quad5.sdo_read(0x1017, 0, "u16")  # CAN1 by default
+    with pytest.raises(canfleet.OrchestratorError, match="no CAN2"):  # a Quad has one port (manual §1)
+        quad5.sdo_read(0x1017, 0, "u16", can=2)
+    for wrong in (0, 3):
+        with pytest.raises(ValueError, match="CAN1.*CAN2"):
+            quad5.sdo_write(0x1017, 0, 100, "u16", can=wrong)
+
+
 def test_io_set_on_one_node_moves_the_output_of_its_pdo_consumer(fleet: Fleet) -> None:
     # quad-5 TPDO1 (185h, AIN1 in mV) -> quad-6 RPDO1 -> POUT1 in mA (Quad manual §3.1.1, §3.5.1).
     assert fleet.node("quad-5").io_set("IN1.voltage_mV", 1800).value == "1800"

@@ -196,7 +196,8 @@ node { name: "q" device: "quad-controller" node_id: 5 bus: "can0" bus: "can1" }
 )");
   EXPECT_THAT(
       e.what(),
-      HasSubstr(":4:55: node[0].bus[0]: quad-controller has 1 CAN port, so node q needs 1 bus; 2 given"));
+      HasSubstr(
+          ":4:55: node[0].bus[0]: quad-controller has 1 CAN port (CAN1), so node q needs 1 bus; 2 given"));
 }
 
 TEST(TopologyDeviceTest, NodeIdCountIsOneOrOnePerPort) {
@@ -204,8 +205,8 @@ TEST(TopologyDeviceTest, NodeIdCountIsOneOrOnePerPort) {
 bus { name: "can0" }
 node { name: "q" device: "quad-controller" node_id: 5 node_id: 6 bus: "can0" }
 )");
-  EXPECT_THAT(e.what(),
-              HasSubstr("node[0].node_id[0]: give one node-ID, or one per port (1 CAN port); 2 given"));
+  EXPECT_THAT(e.what(), HasSubstr("node[0].node_id[0]: give one node-ID, or one per port (quad-controller "
+                                  "has 1 CAN port (CAN1)); 2 given"));
 }
 
 TEST(TopologyDeviceTest, DeviceOrEdsIsRequired) {
@@ -311,8 +312,10 @@ TEST(TopologySdoTest, WritesAreCheckedAgainstTheType) {
               HasSubstr("is not an object index"));
   EXPECT_THAT(Refusal(write("index: 0x1017 subindex: 256 type: \"u16\" value: \"1\"")).what(),
               HasSubstr("node[0].sdo[0].subindex: 256 is not a sub-index"));
+  EXPECT_THAT(Refusal(write("index: 0x1017 type: \"u16\" value: \"1\" can: 2")).what(),
+              HasSubstr("node[0].sdo[0].can: CAN2 does not exist: q has 1 CAN port (CAN1)"));
   EXPECT_THAT(Refusal(write("index: 0x1017 type: \"u16\" value: \"1\" port: 1")).what(),
-              HasSubstr("node[0].sdo[0].port: port 1 does not exist: q has 1 CAN port"));
+              HasSubstr("node[0].sdo[0].port: CAN2 does not exist: q has 1 CAN port (CAN1)"));
 }
 
 TEST(TopologySdoTest, WritesAreCheckedAgainstTheDictionary) {
