@@ -17,6 +17,11 @@ HTML comment right above a block says how to run it (invisible when the README i
     at=SECONDS     run once the fleet's simulated time has reached SECONDS (blocks of one fleet run
                    in the order of their `at`, across files)
     mask=numbers   compare with every decimal number masked (live tables: counters, loads, ages)
+    mask=numbers,events  also `canfleet top`'s recent events: each line under "recent events"
+                   stands for any event (simultaneous events reach the view in either order, and
+                   which of them are the newest five is decided by microseconds)
+    order=any      compare the lines in any order (a real-time run decides simultaneous things in
+                   either order)
     output=any     run the commands and check their exit codes only
     skip=REASON    not run here, and why (another test runs it, or it needs what CI lacks)
     demo=SECONDS   scripts/demo.sh: run it for SECONDS of real time, then Ctrl-C; it must have
@@ -39,6 +44,7 @@ import difflib
 import json
 import os
 import re
+import select
 import shutil
 import signal
 import socket
@@ -48,14 +54,14 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Set
 
 REPO = Path(__file__).resolve().parents[2]
 FILES = Path(__file__).resolve().parent / "files"
-# Simulated seconds per real second of the fleets this runner starts: fast enough that the demo's
-# faults (40, 60, 80 s) come within half a minute, slow enough that a command lands within a few
-# simulated seconds of the time its block asks for.
-SPEED = 4
+# Simulated seconds per real second of the fleets this runner starts: the demo's faults (40, 60,
+# 80 s) come within 40 s, and a command (about a second of real time) lands within two simulated
+# seconds of the time its block asks for, before the next thing the scenario does.
+SPEED = 2
 FLEET_START_TIMEOUT = 120.0
 COMMAND_TIMEOUT = 120.0
 DDS_DOMAIN_BASE = 150  # domains 150.. belong to this test
@@ -91,7 +97,7 @@ def parse_options(text: str, where: str) -> Dict[str, str]:
     # key=value pairs; a value runs to the next " key=" (skip reasons contain spaces).
     for match in re.finditer(r"(\w+)=(.*?)(?=\s+\w+=|$)", text.strip()):
         options[match.group(1)] = match.group(2).strip()
-    known = {"fleet", "at", "mask", "output", "skip", "demo"}
+    known = {"fleet", "at", "mask", "output", "skip", "demo", "order"}
     unknown = set(options) - known
     if unknown:
         raise SystemExit(f"{where}: unknown doc-test option(s) {sorted(unknown)} (known: {sorted(known)})")
@@ -149,32 +155,57 @@ MASKS = [
     (re.compile(r"\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d(\.\d+)?Z?"), "<TIME>"),
     (re.compile(r"\(\d{9,}\.\d+\)"), "(<TIME>)"),  # candump times
     (re.compile(r"\b\d+\.\d+ ?(s|ms|x)\b"), r"<N>\1"),  # measured timings and speed factors
+    (re.compile(r"\b\d\d:\d\d:\d\d\.\d{3}\b"), "<CLOCK>"),  # top's and watch's event times
     (re.compile(r"\b\d+:\d\d:\d\d\b"), "<UPTIME>"),
     (re.compile(r"\bpid \d+"), "pid <PID>"),
-    (re.compile(r"/tmp/[\w.+-]+(/[\w.+-]+)*"), "<TMP>"),
-    (re.compile(r"(/[\w.+-]+)+/(?=[\w.+-]+)"), "<DIR>/"),  # absolute folders (keep the file's name)
+    (re.compile(r"canfleet-(test|doc)-\w+"), r"canfleet-\1-<ID>"),  # mkdtemp's folders
+    (re.compile(r"(/[\w.+<>-]+)+/(?=[\w.+<>-]+)"), "<DIR>/"),  # absolute folders (keep the file's name)
 ]
-NUMBER = re.compile(r"(?<![\w.#-])\d+(\.\d+)?(?![\w.])")
-PAYLOAD = re.compile(r"(#|\"data\":\")[0-9A-Za-z+/=]+")  # candump payloads, base64 in JSON
+# A number alone, or with a unit of time ("16s", "250ms": ages and periods).
+NUMBER = re.compile(r"(?<![\w.#-])\d+(\.\d+)?(?:(?=m?s\b)|(?![\w.]))")
+# A candump record's identifier and payload ("185#B0042003"), a JSON frame's base64 payload.
+PAYLOAD = re.compile(r"\b[0-9A-F]{3}(?:[0-9A-F]{5})?#[0-9A-FR]*|(\"data\":\")[0-9A-Za-z+/=]+")
 
 
 def normalise(line: str, mask_numbers: bool) -> str:
     for pattern, replacement in MASKS:
         line = pattern.sub(replacement, line)
     if mask_numbers:
-        line = PAYLOAD.sub(r"\1<DATA>", line)
+        line = PAYLOAD.sub(lambda m: (m.group(1) + "<DATA>") if m.group(1) else "<ID>#<DATA>", line)
         line = NUMBER.sub("<N>", line)
     return re.sub(r"\s+", " ", line).strip()
 
 
-def matches(expected: List[str], actual: List[str], mask_numbers: bool) -> bool:
+def block_masks(block: "Block") -> Set[str]:
+    masks = set(filter(None, block.options.get("mask", "").split(",")))
+    unknown = masks - {"numbers", "events"}
+    if unknown:
+        raise SystemExit(f"{block.where}: unknown mask(s) {sorted(unknown)} (known: numbers, events)")
+    return masks
+
+
+def normalised(lines: List[str], masks: Set[str]) -> List[str]:
+    out = [normalise(x, "numbers" in masks) if x.strip() != "..." else "..." for x in lines]
+    if "events" in masks:
+        in_events = False
+        for i, line in enumerate(out):
+            if line == "recent events":
+                in_events = True
+            elif in_events and line.startswith("q quit"):
+                in_events = False
+            elif in_events:
+                out[i] = "<EVENT>"
+    while out and out[-1] == "":
+        out.pop()
+    return out
+
+
+def matches(expected: List[str], actual: List[str], masks: Set[str], any_order: bool = False) -> bool:
     """`expected` (with `...` lines standing for any number of lines) against `actual`."""
-    exp = [normalise(x, mask_numbers) if x.strip() != "..." else "..." for x in expected]
-    act = [normalise(x, mask_numbers) for x in actual]
-    while exp and exp[-1] == "":
-        exp.pop()
-    while act and act[-1] == "":
-        act.pop()
+    exp = normalised(expected, masks)
+    act = normalised(actual, masks)
+    if any_order:
+        return sorted(exp) == sorted(act)
 
     def match(e: int, a: int) -> bool:
         if e == len(exp):
@@ -186,7 +217,7 @@ def matches(expected: List[str], actual: List[str], mask_numbers: bool) -> bool:
     return match(0, 0)
 
 
-def updated_output(expected: List[str], actual: List[str], mask_numbers: bool) -> List[str]:
+def updated_output(expected: List[str], actual: List[str]) -> List[str]:
     """The actual lines, with the README's `...` elisions kept where the lines around them still match."""
     if "..." not in [x.strip() for x in expected]:
         return actual
@@ -225,7 +256,9 @@ class Fleet:
         # A copy of topologies/ (its files name EDS files beside them): the fleet's stored parameters
         # go to the copy's .canfleet/, not to the repository's, and no two fleets share them.
         shutil.copytree(REPO / "topologies", self.state / "topologies", ignore=shutil.ignore_patterns(".canfleet"))
-        self.topology = self.state / "topologies" / f"{topology_name}.textproto"
+        # Named relative to the fleet's folder, its working folder: what the fleet prints (verdicts
+        # name their file) reads as a user's `canfleet up topologies/demo.textproto` does.
+        self.topology = Path("topologies") / f"{topology_name}.textproto"
         self.control = f"tcp://127.0.0.1:{free_port()}"
         self.domain = domain
         self.log = self.state / "orchestrator.log"
@@ -298,24 +331,32 @@ def run_demo(block: Block, seconds: float, env: Dict[str, str]) -> List[str]:
     """scripts/demo.sh for `seconds`, then Ctrl-C: what went wrong, or nothing."""
     problems: List[str] = []
     proc = subprocess.Popen(["bash", str(REPO / "scripts" / "demo.sh")], cwd=REPO, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
-    output: List[str] = []
-    deadline = time.monotonic() + seconds
-    os.set_blocking(proc.stdout.fileno(), False)
-    while time.monotonic() < deadline and proc.poll() is None:
-        chunk = proc.stdout.read()
-        if chunk:
-            output.append(chunk)
-        time.sleep(0.2)
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+    assert proc.stdout is not None
+    fd = proc.stdout.fileno()
+    output: List[bytes] = []
+
+    def drain(until: float) -> None:
+        # Raw reads of the pipe (no text layer: a non-blocking TextIOWrapper fails on an empty read).
+        while time.monotonic() < until:
+            ready, _, _ = select.select([fd], [], [], max(0.0, min(0.2, until - time.monotonic())))
+            if ready:
+                chunk = os.read(fd, 65536)
+                if not chunk:
+                    return  # every writer closed the pipe
+                output.append(chunk)
+            elif proc.poll() is not None:
+                return
+
+    drain(time.monotonic() + seconds)
     os.killpg(proc.pid, signal.SIGINT)
+    drain(time.monotonic() + 60)
     try:
-        proc.wait(timeout=60)
+        proc.wait(timeout=5)
     except subprocess.TimeoutExpired:
         os.killpg(proc.pid, signal.SIGKILL)
         problems.append("scripts/demo.sh did not stop within 60 s of Ctrl-C")
-    os.set_blocking(proc.stdout.fileno(), True)
-    output.append(proc.stdout.read() or "")
-    text = "".join(output)
+    text = b"".join(output).decode(errors="replace")
     for needed in ("live view", "canfleet top", "demo stopped"):
         if needed not in text:
             problems.append(f"scripts/demo.sh never printed {needed!r}")
@@ -394,7 +435,7 @@ def main() -> int:
                 env.update(fleet.env())
             run_block(block, work, env)
             ran += 1
-            mask = block.options.get("mask") == "numbers"
+            mask = block_masks(block)
             for index, command in enumerate(block.commands):
                 # A command may fail where the README shows it failing: its status is shown next, or
                 # its output is the tool's error line.
@@ -406,8 +447,11 @@ def main() -> int:
                     continue
                 if block.options.get("output") == "any" or not block.prompted:
                     continue
-                if not matches(command.expected, command.actual, mask):
-                    diff = difflib.unified_diff(command.expected, command.actual, "README", "actual", lineterm="")
+                any_order = block.options.get("order") == "any"
+                if not matches(command.expected, command.actual, mask, any_order):
+                    # The lines as compared (masked), so that the difference that counts stands out.
+                    diff = difflib.unified_diff(normalised(command.expected, mask), normalised(command.actual, mask),
+                                                "README (masked)", "actual (masked)", lineterm="")
                     failures.append(f"{block.where}: `{command.line}` printed something else:\n  " +
                                     "\n  ".join(diff))
     finally:
@@ -435,11 +479,10 @@ def write_updates(blocks: List[Block]) -> None:
     for path, file_blocks in by_file.items():
         lines = path.read_text().splitlines()
         for block in sorted(file_blocks, key=lambda b: b.body_range[0], reverse=True):
-            mask = block.options.get("mask") == "numbers"
             body: List[str] = []
             for command in block.commands:
                 body.append("$ " + command.line)
-                body += [line.rstrip() for line in updated_output(command.expected, command.actual, mask)]
+                body += [line.rstrip() for line in updated_output(command.expected, command.actual)]
             start, end = block.body_range
             lines[start:end] = body
         path.write_text("\n".join(lines) + "\n")
