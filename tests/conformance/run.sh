@@ -17,28 +17,11 @@ if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
   build="$1"
   shift
 fi
-build="$(cd "$build" 2>/dev/null && pwd)" || { echo "conformance: no build folder '$build'" >&2; exit 2; }
-for tool in canfleet canfleet-node; do
-  if [ ! -x "$build/bin/$tool" ]; then
-    echo "conformance: $build/bin/$tool is missing (build the project first)" >&2
-    exit 2
-  fi
-done
-
-env_status=0
-env_out="$("$repo/scripts/python-env.sh" 2>&1)" || env_status=$?
-if [ "$env_status" -ne 0 ]; then
-  echo "conformance: scripts/python-env.sh could not provide the venv (exit $env_status):" >&2
-  echo "$env_out" >&2
-  # 75: PyPI unreachable, the machine's limit: skipped (77, ctest's SKIP_RETURN_CODE), said above.
-  # Anything else (our package does not build) is a failure.
-  [ "$env_status" -eq 75 ] && exit 77
-  exit 1
-fi
-python="$(printf '%s\n' "$env_out" | tail -n 1)"
+# shellcheck source=scripts/python-suite.sh
+source "$repo/scripts/python-suite.sh"
+python_suite_setup "conformance" "$build"
 
 cd "$here"
-export PYTHONDONTWRITEBYTECODE=1  # no __pycache__ in the source tree
 echo "conformance: $("$python" -c 'import canopen, can; print(f"python-canopen {canopen.__version__}, python-can {can.__version__}")'), binaries from $build/bin"
 export CANFLEET_BUILD_DIR="$build"
 exec "$python" -m pytest "--build-dir=$build" "$@"

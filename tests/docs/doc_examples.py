@@ -327,6 +327,23 @@ def run_block(block: Block, work: Path, env: Dict[str, str]) -> None:
         command.status = int(parts[2 * index + 1]) if 2 * index + 1 < len(parts) else -1
 
 
+def session_processes(sid: int) -> List[str]:
+    """The live processes of session `sid` ("PID COMMAND"), zombies left out."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace").strip()
+        except OSError:
+            continue  # gone meanwhile
+        fields = stat.rsplit(")", 1)[1].split()  # after "pid (comm)": state ppid pgrp session ...
+        if int(fields[3]) == sid and fields[0] != "Z":
+            found.append(f"{entry.name} {cmdline}")
+    return found
+
+
 def run_demo(block: Block, seconds: float, env: Dict[str, str]) -> List[str]:
     """scripts/demo.sh for `seconds`, then Ctrl-C: what went wrong, or nothing."""
     problems: List[str] = []
@@ -360,9 +377,11 @@ def run_demo(block: Block, seconds: float, env: Dict[str, str]) -> List[str]:
     for needed in ("live view", "canfleet top", "demo stopped"):
         if needed not in text:
             problems.append(f"scripts/demo.sh never printed {needed!r}")
-    left = subprocess.run(["pgrep", "-f", f"{REPO}/build/bin/canfleet"], capture_output=True, text=True).stdout
-    if left.strip():
-        problems.append(f"processes left after Ctrl-C: {left.split()}")
+    # The demo's processes are those of its session (start_new_session; the fleet's children get
+    # process groups of their own, never sessions): other tests' canfleet processes do not count.
+    left = session_processes(proc.pid)
+    if left:
+        problems.append(f"processes left after Ctrl-C: {left}")
     if problems:
         problems.append("its output (end):\n" + text[-3000:])
     return problems

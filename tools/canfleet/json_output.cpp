@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tools/canfleet/cli.hpp"
+#include "tools/telemetry/event_format.hpp"
 
 namespace canfleet::cli {
 
@@ -17,36 +18,9 @@ namespace {
 
 namespace pb = google::protobuf;
 
+// One JSON string escaping for the CLI and the telemetry tools (canfleet watch --json).
 std::string Quoted(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          out += buffer;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
+  return tools::JsonString(text);
 }
 
 std::string Base64(std::string_view bytes) {

@@ -1,0 +1,26 @@
+# Sourced by the Python suites (python/run-tests.sh, tests/conformance/run.sh): what they share
+# before pytest. python_suite_setup LABEL BUILD_DIR checks the build's binaries and gets the venv
+# (scripts/python-env.sh), then sets `build` (absolute) and `python` (the venv's interpreter). Exits
+# 2 when the build is missing, 77 (ctest's SKIP_RETURN_CODE) when PyPI cannot be reached for the
+# venv (python-env.sh exit 75, the machine's limit), 1 when the venv fails otherwise (our package
+# does not build: a failure, never a skip).
+python_suite_setup() {
+  local label=$1 tool env_status=0 env_out repo
+  repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+  build="$(cd "$2" 2>/dev/null && pwd)" || { echo "$label: no build folder '$2'" >&2; exit 2; }
+  for tool in canfleet canfleet-node; do
+    if [ ! -x "$build/bin/$tool" ]; then
+      echo "$label: $build/bin/$tool is missing (build the project first)" >&2
+      exit 2
+    fi
+  done
+  env_out="$("$repo/scripts/python-env.sh" 2>&1)" || env_status=$?
+  if [ "$env_status" -ne 0 ]; then
+    echo "$label: scripts/python-env.sh could not provide the venv (exit $env_status):" >&2
+    echo "$env_out" >&2
+    [ "$env_status" -eq 75 ] && exit 77
+    exit 1
+  fi
+  python="$(printf '%s\n' "$env_out" | tail -n 1)"
+  export PYTHONDONTWRITEBYTECODE=1  # no __pycache__ in the source tree
+}
