@@ -35,10 +35,11 @@ std::string IgnoredInput(const IoSignal& input, const InputPin& pin) {
   const IoSignal* read = ReadSignal(pin);
   if (read == &input) return {};
   const std::string sub = std::to_string(pin.sub);
-  return IgnoredNotice(input,
-                       pin.channel + "'s configuration (6112h sub " + sub + " = " + std::to_string(pin.mode) +
-                           ", 6110h sub " + sub + " = " + std::to_string(pin.sensor_type) + ")",
-                       read != nullptr ? "it reads " + read->name() : std::string("it reads none of the pin's signals"));
+  return IgnoredNotice(
+      input,
+      pin.channel + "'s configuration (6112h sub " + sub + " = " + std::to_string(pin.mode) + ", 6110h sub " +
+          sub + " = " + std::to_string(pin.sensor_type) + ")",
+      read != nullptr ? "it reads " + read->name() : std::string("it reads none of the pin's signals"));
 }
 
 }  // namespace canfleet::devices::family

@@ -76,9 +76,10 @@ TEST_F(QuadSignalTest, CurrentInputsAreInMilliamperes) {
 TEST_F(QuadSignalTest, ASetTheConfigurationIgnoresSaysSo) {
   const IoStatus level = io().SetEnum("IN2.level", "high");
   ASSERT_TRUE(level.ok());
-  EXPECT_EQ(level.notice,
-            "IN2.level is set, but IN2's configuration (6112h sub 2 = 1, 6110h sub 2 = 40) does not read it (it "
-            "reads IN2.voltage_mV)");
+  EXPECT_EQ(
+      level.notice,
+      "IN2.level is set, but IN2's configuration (6112h sub 2 = 1, 6110h sub 2 = 40) does not read it (it "
+      "reads IN2.voltage_mV)");
   EXPECT_EQ(io().SetNumber("IN2.voltage_mV", 1000).notice, "");
   Write(0x6112, 2, 10, 1);
   EXPECT_EQ(io().SetEnum("IN2.level", "low").notice, "");
