@@ -71,6 +71,10 @@ canfleet_telemetry_NmtState ToDds(std::optional<NmtState> state) {
 }
 
 std::optional<NmtState> FromDds(canfleet_telemetry_NmtState state) {
+  return NmtStateFromRaw(state);
+}
+
+std::optional<NmtState> NmtStateFromRaw(std::int32_t state) {
   switch (state) {
     case canfleet_telemetry_NMT_UNKNOWN:
       return std::nullopt;
@@ -99,6 +103,10 @@ canfleet_telemetry_ControllerState ToDds(ControllerState state) {
 }
 
 ControllerState FromDds(canfleet_telemetry_ControllerState state) {
+  return ControllerStateFromRaw(state);
+}
+
+ControllerState ControllerStateFromRaw(std::int32_t state) {
   switch (state) {
     case canfleet_telemetry_CONTROLLER_ERROR_ACTIVE:
       return ControllerState::kErrorActive;
@@ -123,6 +131,10 @@ canfleet_telemetry_HeartbeatConsumerState ToDds(HeartbeatConsumerState state) {
 }
 
 HeartbeatConsumerState FromDds(canfleet_telemetry_HeartbeatConsumerState state) {
+  return HeartbeatConsumerStateFromRaw(state);
+}
+
+HeartbeatConsumerState HeartbeatConsumerStateFromRaw(std::int32_t state) {
   switch (state) {
     case canfleet_telemetry_HB_CONSUMER_UNKNOWN:
       return HeartbeatConsumerState::kUnknown;
@@ -140,6 +152,10 @@ canfleet_telemetry_FaultAction ToDds(FaultAction action) {
 }
 
 FaultAction FromDds(canfleet_telemetry_FaultAction action) {
+  return FaultActionFromRaw(action);
+}
+
+FaultAction FaultActionFromRaw(std::int32_t action) {
   return action == canfleet_telemetry_FAULT_CLEARED ? FaultAction::kCleared : FaultAction::kInjected;
 }
 
@@ -158,6 +174,10 @@ canfleet_telemetry_VerdictResult ToDds(VerdictResult result) {
 }
 
 VerdictResult FromDds(canfleet_telemetry_VerdictResult result) {
+  return VerdictResultFromRaw(result);
+}
+
+VerdictResult VerdictResultFromRaw(std::int32_t result) {
   switch (result) {
     case canfleet_telemetry_VERDICT_PASS:
       return VerdictResult::kPass;
@@ -203,9 +223,9 @@ NodeStatusSample FromDds(const canfleet_telemetry_NodeStatus& s) {
   out.node_id = s.node_id;
   out.device = FromBounded(s.device);
   out.name = FromBounded(s.name);
-  out.nmt_state = FromDds(s.nmt_state);
+  out.nmt_state = NmtStateFromRaw(RawEnum(s.nmt_state));
   out.error_register = s.error_register;
-  out.controller_state = FromDds(s.controller_state);
+  out.controller_state = ControllerStateFromRaw(RawEnum(s.controller_state));
   out.tec = s.tec;
   out.rec = s.rec;
   out.heartbeat_producer_ms = s.heartbeat_producer_ms;
@@ -213,7 +233,8 @@ NodeStatusSample FromDds(const canfleet_telemetry_NodeStatus& s) {
   out.heartbeat_consumers.reserve(n);
   for (std::uint32_t i = 0; i < n; ++i) {
     const auto& c = s.heartbeat_consumers._buffer[i];
-    out.heartbeat_consumers.push_back({c.node_id, c.time_ms, FromDds(c.state), FromDds(c.last_state)});
+    out.heartbeat_consumers.push_back({c.node_id, c.time_ms, HeartbeatConsumerStateFromRaw(RawEnum(c.state)),
+                                       NmtStateFromRaw(RawEnum(c.last_state))});
   }
   out.rpdo_count = s.rpdo_count;
   out.tpdo_count = s.tpdo_count;
@@ -269,7 +290,7 @@ FaultEventSample FromDds(const canfleet_telemetry_FaultEvent& s) {
   FaultEventSample out;
   out.bus = FromBounded(s.bus);
   out.fault_id = s.fault_id;
-  out.action = FromDds(s.action);
+  out.action = FaultActionFromRaw(RawEnum(s.action));
   out.kind = FromBounded(s.kind);
   out.target_node = s.target_node;
   for (std::uint32_t i = 0; i < BoundedLength(s.parameters, kMaxFaultParameters); ++i) {
@@ -287,7 +308,7 @@ VerdictSample FromDds(const canfleet_telemetry_Verdict& s) {
   out.index = s.index;
   out.scenario = FromBounded(s.scenario);
   out.cycle = s.cycle;
-  out.result = FromDds(s.result);
+  out.result = VerdictResultFromRaw(RawEnum(s.result));
   out.name = FromBounded(s.name);
   out.line = s.line;
   out.text = FromBounded(s.text);

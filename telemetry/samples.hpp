@@ -5,6 +5,7 @@
 #include <chrono>
 #include <compare>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -147,6 +148,22 @@ canfleet_telemetry_FaultAction ToDds(FaultAction action);
 FaultAction FromDds(canfleet_telemetry_FaultAction action);
 canfleet_telemetry_VerdictResult ToDds(VerdictResult result);
 VerdictResult FromDds(canfleet_telemetry_VerdictResult result);
+// The same from an enum field's integer, as a received sample is read: a hostile or newer writer
+// may send a value the IDL enum lacks, and loading it as the C enum would be undefined behaviour
+// (UBSan's -fsanitize=enum); unknown values map as the functions above document.
+std::optional<NmtState> NmtStateFromRaw(std::int32_t state);
+ControllerState ControllerStateFromRaw(std::int32_t state);
+HeartbeatConsumerState HeartbeatConsumerStateFromRaw(std::int32_t state);
+FaultAction FaultActionFromRaw(std::int32_t action);
+VerdictResult VerdictResultFromRaw(std::int32_t result);
+/// An IDL enum field of a sample as its integer, without loading it as the enum.
+template <typename Enum>
+std::int32_t RawEnum(const Enum& field) {
+  static_assert(sizeof(Enum) == sizeof(std::int32_t), "IDL enums are 32-bit");
+  std::int32_t raw = 0;
+  std::memcpy(&raw, &field, sizeof raw);
+  return raw;
+}
 
 /// Copies `text` into a bounded IDL string (char[N]), truncating to N-1 characters.
 template <std::size_t N>
