@@ -161,8 +161,9 @@ MASKS = [
     (re.compile(r"canfleet-(test|doc)-\w+"), r"canfleet-\1-<ID>"),  # mkdtemp's folders
     (re.compile(r"(/[\w.+<>-]+)+/(?=[\w.+<>-]+)"), "<DIR>/"),  # absolute folders (keep the file's name)
 ]
-# A number alone, or with a unit of time ("16s", "250ms": ages and periods).
-NUMBER = re.compile(r"(?<![\w.#-])\d+(\.\d+)?(?:(?=m?s\b)|(?![\w.]))")
+# A number alone, with a unit of time ("16s", "250ms": ages and periods) or as a factor ("2.0x real
+# time": achieved, so a loaded machine shows 1.9x).
+NUMBER = re.compile(r"(?<![\w.#-])\d+(\.\d+)?(?:(?=m?s\b|x\b)|(?![\w.]))")
 # A candump record's identifier and payload ("185#B0042003"), a JSON frame's base64 payload.
 PAYLOAD = re.compile(r"\b[0-9A-F]{3}(?:[0-9A-F]{5})?#[0-9A-FR]*|(\"data\":\")[0-9A-Za-z+/=]+")
 
