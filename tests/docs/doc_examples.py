@@ -160,6 +160,9 @@ MASKS = [
     (re.compile(r"\bpid \d+"), "pid <PID>"),
     (re.compile(r"canfleet-(test|doc)-\w+"), r"canfleet-\1-<ID>"),  # mkdtemp's folders
     (re.compile(r"(/[\w.+<>-]+)+/(?=[\w.+<>-]+)"), "<DIR>/"),  # absolute folders (keep the file's name)
+    # A fault table's HITS (`canfleet fault list`, `status`): frames a fault touched so far, which
+    # depends on the instant the command lands (FAULT STATE STARTED ENDED HITS LABEL SUMMARY).
+    (re.compile(r"^(\s*\d+\s+[a-z]+\s+\S+\s+\S+\s+)\d+(?=\s)"), r"\1<HITS>"),
 ]
 # A number alone, with a unit of time ("16s", "250ms": ages and periods) or as a factor ("2.0x real
 # time": achieved, so a loaded machine shows 1.9x).
