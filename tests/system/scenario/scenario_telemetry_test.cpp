@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "tests/support/text_lines.hpp"
 #include "tests/system/fleet/fleet_harness.hpp"
 #include "tests/system/telemetry/dds_monitor.hpp"
 
@@ -55,13 +56,7 @@ const FleetEvent* FindVerdict(const Monitor& monitor, const std::string& name) {
   return nullptr;
 }
 
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
+using ::canfleet::test::Lines;
 
 TEST(ScenarioTelemetry, VerdictsAndTheScenarioClockReachDdsTopAndWatch) {
   FleetUnderTest fleet{UseTestDomain()};

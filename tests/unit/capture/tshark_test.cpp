@@ -13,6 +13,7 @@
 
 #include "bus/capture/pcap_writer.hpp"
 #include "tests/support/bus_probe.hpp"
+#include "tests/support/text_lines.hpp"
 #include "tests/unit/capture/capture_test_support.hpp"
 
 namespace canfleet::capture {
@@ -41,13 +42,7 @@ std::string RunCommand(const std::string& command, const std::filesystem::path& 
   return out;
 }
 
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
+using ::canfleet::test::Lines;
 
 #define SKIP_WITHOUT_TSHARK()                                                 \
   if (!HaveTshark())                                                          \

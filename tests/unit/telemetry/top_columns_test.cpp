@@ -6,6 +6,7 @@
 
 #include <sstream>
 
+#include "tests/support/text_lines.hpp"
 #include "tools/telemetry/node_detail.hpp"
 #include "tools/telemetry/text_fit.hpp"
 #include "tools/telemetry/top_format.hpp"
@@ -23,13 +24,7 @@ SampleMeta At(WallTime t) {
   return {.source_time = t};
 }
 
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
+using ::canfleet::test::Lines;
 
 /// The header line of the node table.
 std::string Header(const std::vector<std::string>& lines) {

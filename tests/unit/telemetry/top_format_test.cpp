@@ -1,6 +1,7 @@
 // `canfleet top`: row selection, ordering, paging and the rendered screen.
 #include "tools/telemetry/top_format.hpp"
 
+#include "tests/support/text_lines.hpp"
 #include "tools/telemetry/node_detail.hpp"
 
 #include <gtest/gtest.h>
@@ -38,13 +39,7 @@ std::vector<int> Ids(const std::vector<const NodeRow*>& rows) {
   return ids;
 }
 
-std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
+using ::canfleet::test::Lines;
 
 class TopFormat : public ::testing::Test {
  protected:
