@@ -2,6 +2,7 @@
 /// @file The seam between the control API's transport (ControlServer) and what answers it (the
 /// fleet manager, or a fake in unit tests).
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 
@@ -20,6 +21,12 @@ class Responder {
   virtual bool Closed() const = 0;
   /// Called once when the client goes (immediately if it already has): dumps unsubscribe here.
   virtual void OnClose(std::function<void()> handler) = 0;
+  /// How many responses were sent on the connection so far (its clients count them too:
+  /// ClockAdvance.responses_seen).
+  virtual std::uint64_t Sent() const { return 0; }
+  /// Runs `hook` after each later response on the connection (the clock's driver: an answer
+  /// ends the running step). One hook; a new one replaces it.
+  virtual void OnSent(std::function<void()> /*hook*/) {}
 };
 
 /// Answers requests. Every Request gets exactly one Response with its id, except DumpRequest,

@@ -13,8 +13,14 @@ class SessionResponder final : public Responder {
   explicit SessionResponder(std::weak_ptr<ControlSession> session) : session_(std::move(session)) {}
 
   void Send(const Response& response) override {
-    if (const auto s = session_.lock()) s->Send(response);
+    const auto s = session_.lock();
+    if (!s) return;
+    s->Send(response);
+    ++sent_;
+    if (on_sent_) on_sent_();
   }
+  std::uint64_t Sent() const override { return sent_; }
+  void OnSent(std::function<void()> hook) override { on_sent_ = std::move(hook); }
   bool Closed() const override {
     const auto s = session_.lock();
     return !s || s->Closed();
@@ -29,6 +35,8 @@ class SessionResponder final : public Responder {
 
  private:
   std::weak_ptr<ControlSession> session_;
+  std::uint64_t sent_ = 0;
+  std::function<void()> on_sent_;
 };
 
 Response ErrorResponse(std::uint64_t id, std::string error) {

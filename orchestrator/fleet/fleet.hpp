@@ -20,6 +20,7 @@
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/broker_telemetry/scenario_telemetry.hpp"
 #include "orchestrator/control/control_handler.hpp"
+#include "orchestrator/fleet/asked_expectation.hpp"
 #include "orchestrator/fleet/external_adoption.hpp"
 #include "orchestrator/fleet/fault_manager.hpp"
 #include "orchestrator/fleet/fleet_node.hpp"
@@ -51,7 +52,7 @@ struct FleetOptions {
   /// (`canfleet test` judges one run).
   bool repeat_scenario = false;
   /// Virtual time: the broker's time conductor (status shows simulated time and the factor).
-  const transport::TimeConductor* conductor = nullptr;
+  transport::TimeConductor* conductor = nullptr;
   /// Seed of the random draws of faults that give none (topology `time.seed`).
   std::uint64_t seed = 0;
   /// The topology file as given (`canfleet up FILE`, `canfleet test FILE`): result lines and
@@ -175,6 +176,9 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   void IoRequest(const std::string& node, wire::NodeRequest request,
                  std::function<void(const IoAnswer&)> done);
   void StartDump(const control::Request& request, std::shared_ptr<control::Responder> responder);
+  // fleet_clock.cpp: a test driving virtual time, and expectations asked through the control API.
+  void AdvanceClock(const control::Request& request, std::shared_ptr<control::Responder> responder);
+  void StartExpect(const control::Request& request, std::shared_ptr<control::Responder> responder);
   void RunStep(const topology::Step& step);
 
   double Uptime() const;
@@ -205,6 +209,8 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   std::optional<TimePoint> final_origin_;
   std::vector<std::unique_ptr<ScenarioTap>> scenario_taps_;  ///< listen-only, one per bus, for expectations
   bool ready_ = false;
+  std::map<std::uint64_t, std::unique_ptr<AskedExpectation>> asked_;  ///< ExpectRequests being judged
+  std::uint64_t next_asked_ = 1;
 
   std::function<void()> on_ready_;
   std::function<void()> on_shutdown_request_;

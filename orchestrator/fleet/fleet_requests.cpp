@@ -123,6 +123,12 @@ void Fleet::Handle(const control::Request& request, std::shared_ptr<control::Res
         responder->Send(DoneReply(request, line));
         return;
       }
+      case R::kClockAdvance:
+        AdvanceClock(request, responder);
+        return;
+      case R::kExpect:
+        StartExpect(request, responder);
+        return;
       case R::kShutdown:
         responder->Send(DoneReply(request, "shutting down"));
         if (on_shutdown_request_) asio::post(io_, on_shutdown_request_);
@@ -148,6 +154,8 @@ control::Status Fleet::Status() const {
     status.set_virtual_time(true);
     status.set_speed_factor(options_.conductor->Factor());
     status.set_speed(options_.conductor->Speed());
+    status.set_driven(options_.conductor->Driven());
+    status.set_now_ns(options_.conductor->Now().time_since_epoch().count());
   }
   std::map<std::pair<std::string, std::string>, broker::PortStats> ports;  // (bus, name)
   std::map<std::string, std::uint32_t> bus_rates;

@@ -19,7 +19,7 @@ host::HostTime FleetTime(const topology::Topology& spec, const TimeOverride& ove
   return time;
 }
 
-void UseHostTime(FleetOptions& options, const transport::TimeConductor* conductor) {
+void UseHostTime(FleetOptions& options, transport::TimeConductor* conductor) {
   options.conductor = conductor;
   if (conductor != nullptr)
     options.node_arguments.insert(options.node_arguments.end(), {"--time", "virtual"});

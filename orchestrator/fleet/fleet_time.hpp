@@ -43,7 +43,7 @@ class BoundaryControlHandler final : public control::ControlHandler {
 
 /// In virtual time (a conductor): the fleet's nodes run on the broker's clock (--time virtual) and
 /// its status shows simulated time. Nothing in real time (nullptr).
-void UseHostTime(FleetOptions& options, const transport::TimeConductor* conductor);
+void UseHostTime(FleetOptions& options, transport::TimeConductor* conductor);
 
 /// What the control server serves: the fleet itself, or in virtual time the fleet between rounds
 /// (a BoundaryControlHandler made in `holder`, which must outlive the server).

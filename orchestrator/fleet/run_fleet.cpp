@@ -104,6 +104,10 @@ int RunFleet(const UpOptions& options) {
     std::cerr << "canfleet up: " << e.what() << "\n";
     return 2;
   }
+  if (options.driven && !time.virtual_time) {
+    std::cerr << "canfleet up: --driven needs virtual time (--time virtual)\n";
+    return 2;
+  }
   host::BrokerHost host(io, socketcand_options, time);
   std::unique_ptr<Fleet> fleet;
   std::unique_ptr<BoundaryControlHandler> boundary;
@@ -188,13 +192,21 @@ int RunFleet(const UpOptions& options) {
     if (stopping) return;
     stopping = true;
     spdlog::info("{}: stopping the fleet", why);
+    // Driven time runs on its own while the nodes stop: nobody steps it any more.
+    if (auto* conductor = host.conductor(); conductor != nullptr && conductor->Driven()) conductor->Undrive();
     fleet->Stop([&] {
       spdlog::info("every node process has stopped");
       control_server->Close();
       host.Stop();
     });
   };
-  fleet->OnReady([&] { WriteStateFile(options.ready_file, control_endpoint, broker_endpoint, "ready"); });
+  fleet->OnReady([&] {
+    // Driven: the fleet stops at the end of the round in which it became ready, the same
+    // simulated instant on every run, and waits for its test's first step.
+    if (options.driven && host.conductor() != nullptr && !host.conductor()->Driven())
+      host.conductor()->Drive();
+    WriteStateFile(options.ready_file, control_endpoint, broker_endpoint, "ready");
+  });
   fleet->OnShutdownRequest([&] { shutdown("canfleet down"); });
   host.OnSignal(shutdown);
   fleet->Start();
@@ -203,6 +215,9 @@ int RunFleet(const UpOptions& options) {
                                          ? "paced at " + std::to_string(conductor->Speed()) + "x real time"
                                          : std::string("as fast as the processes go"));
     if (!options.no_start) conductor->HoldUntilJoined(NodeProcesses(spec), kJoinTimeout);
+    // A fleet that starts no node process is driven from time 0: its nodes (started by the test,
+    // as the conformance suite does) join a fleet that stands still.
+    if (options.driven && options.no_start) conductor->Drive();
   }
   io.run();
   scenario_telemetry.reset();  // before the fleet, whose hooks call it

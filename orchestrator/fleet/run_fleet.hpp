@@ -22,6 +22,9 @@ struct UpOptions {
   std::filesystem::path ready_file;  ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
   std::string log_level = "info";
   bool no_start = false;  ///< load and start the buses, but no node processes
+  /// Virtual time: from the moment the fleet is ready, time runs only inside a client's
+  /// ClockAdvance (TimeConductor::Drive).
+  bool driven = false;
   bool telemetry = true;  ///< BusStats and FaultEvents on DDS
   /// Where the orchestrator publishes (canfleet up's --dds-* options); also passed to its nodes.
   telemetry::DdsOptions dds;

@@ -289,7 +289,16 @@ void NodeSession::OnHello(const wire::Hello& hello) {
            "real-time clients may only watch (monitor role)");
     return;
   }
-  if (conductor != nullptr && !monitor && hello.clock_id().empty()) {
+  if (hello.driven() && (conductor == nullptr || !conductor->Driven() || !hello.clock_id().empty())) {
+    Refuse(conductor == nullptr ? "bus " + hello.bus() + " runs in real time: nothing to drive"
+           : !hello.clock_id().empty()
+               ? std::string("a driven participant names no clock (Hello.clock_id): it is granted no time")
+               : "bus " + hello.bus() +
+                     " runs in virtual time on its own: a driven participant joins a fleet whose time a test "
+                     "runs in steps (canfleet up --driven, as Fleet.up(time='virtual') starts it)");
+    return;
+  }
+  if (conductor != nullptr && !monitor && !hello.driven() && hello.clock_id().empty()) {
     Refuse("a node in virtual time must name its clock (Hello.clock_id)");
     return;
   }
@@ -341,11 +350,16 @@ void NodeSession::Accept(const wire::Hello& hello) {
   filling_.AddHelloReply(reply);
   ScheduleFlush();
   stats_->attached++;
-  if (conductor != nullptr && hello.role() != wire::ROLE_MONITOR) {
+  if (hello.driven()) {
+    driven_ = true;
+  } else if (conductor != nullptr && hello.role() != wire::ROLE_MONITOR) {
     granted_ = true;
     conductor->Join(*this, hello.clock_id(), hello.clock_attachment(), hello.clock_ports());
   }
-  spdlog::info("{}: attached ({}{}{})", label_, hello.role() == wire::ROLE_MONITOR ? "monitor" : "node",
+  spdlog::info("{}: attached ({}{}{})", label_,
+               hello.role() == wire::ROLE_MONITOR ? "monitor"
+               : hello.driven()                   ? "driven participant"
+                                                  : "node",
                hello.node_id() != 0 ? ", node-ID " + std::to_string(hello.node_id()) : std::string(),
                RateNote(hello.bitrate(), bus.bitrate));
 }
@@ -478,6 +492,7 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
   // In virtual time the grant that follows sends the frames: frames and grant in one write.
   if (!granted_ && !write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&
       frames <= wire::kMaxFramesPerMessage) {
+    if (driven_) options_.time_conductor->Wake();  // before the write, which may close the session
     WriteGathered(records, runs, frames);
     return;
   }

@@ -91,10 +91,12 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   /// Something was queued for the node: in real time it leaves at the end of this turn; in
   /// virtual time it happened now, and leaves with the grant of the next round.
   void Queued() {
-    if (granted_)
+    if (granted_) {
       options_.time_conductor->Pending(*this);
-    else
-      ScheduleFlush();
+      return;
+    }
+    if (driven_) options_.time_conductor->Wake();  // the driver's step ends where this happened
+    ScheduleFlush();
   }
   /// Reads what the socket holds, then waits for more (bus/wire/socket_io.hpp).
   void Read();
@@ -139,6 +141,7 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   bool closed_ = false;
   bool hello_seen_ = false;  ///< a Hello arrived (in virtual time it is accepted between rounds)
   bool granted_ = false;     ///< a node in virtual time: the conductor grants its time
+  bool driven_ = false;      ///< a participant of the process that drives time (Hello.driven)
   /// The node's acceptance filter (Acceptance), in real and virtual time; until it sends one,
   /// every frame.
   bool accept_all_ = true;

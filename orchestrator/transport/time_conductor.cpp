@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <asio/post.hpp>
+#include <stdexcept>
 
 namespace canfleet::transport {
 
@@ -129,6 +130,42 @@ void TimeConductor::Release() {
   if (holds_ > 0 && --holds_ == 0) Kick();
 }
 
+void TimeConductor::Drive() {
+  ++drives_;
+}
+
+void TimeConductor::Undrive() {
+  if (drives_ > 0 && --drives_ == 0) {
+    if (advance_done_) FinishAdvance();
+    Kick();
+  }
+}
+
+void TimeConductor::Advance(TimePoint until, std::function<void(bool woken)> done) {
+  if (drives_ == 0) throw std::logic_error("time is not driven: it runs on its own");
+  if (advance_done_) throw std::logic_error("an advance is already running");
+  advance_until_ = until;
+  advance_woken_ = false;
+  advance_done_ = std::move(done);
+  Kick();
+}
+
+bool TimeConductor::AdvanceStops() {
+  if (!advance_done_) return true;
+  if (!advance_woken_ && Now() < advance_until_) return false;
+  FinishAdvance();
+  return true;
+}
+
+void TimeConductor::FinishAdvance() {
+  auto done = std::move(advance_done_);
+  advance_done_ = nullptr;
+  const bool woken = advance_woken_;
+  advance_woken_ = false;
+  run_wall_start_.reset();  // time stands still until the next Advance: pacing starts again then
+  if (done) done(woken);
+}
+
 std::size_t TimeConductor::JoinedProcesses() const {
   return static_cast<std::size_t>(std::ranges::count_if(
       participants_, [](const auto& entry) { return entry.second.sessions.size() >= entry.second.ports; }));
@@ -194,12 +231,22 @@ bool TimeConductor::OpenRound() {
     if (t && (!node_next || *t < *node_next)) node_next = t;
   }
   const std::optional<TimePoint> broker_next = scheduler_.NextDeadline();
-  if (holds_ > 0 || participants_.empty() || (!node_next && !broker_next)) {
+  if (holds_ == 0 && drives_ > 0) {
+    if (AdvanceStops()) return false;
+    if (!node_next && !broker_next) {
+      // Nothing happens before the step's end: the fleet is there at once.
+      scheduler_.AdvanceTo(advance_until_);
+      FinishAdvance();
+      return false;
+    }
+  }
+  if (holds_ > 0 || (participants_.empty() && drives_ == 0) || (!node_next && !broker_next)) {
     run_wall_start_.reset();  // time stands still: pacing and the factor start again
     return false;
   }
   TimePoint until = broker_next ? *broker_next : TimePoint::max();
   if (node_next) until = std::min(until, *node_next + kLookahead);
+  if (drives_ > 0) until = std::min(until, advance_until_);
   if (until <= now) until = now + Duration(1);
 
   const auto wall_now = std::chrono::steady_clock::now();

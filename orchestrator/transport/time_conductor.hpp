@@ -120,6 +120,24 @@ class TimeConductor {
   /// `timeout` of real time has passed (then it says how many joined, and time goes on).
   void HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout);
 
+  // --- a driver: a test process that runs the fleet's time in steps (python/canfleet) ---
+  /// From the next round on, time runs only inside Advance() (until as many Undrive() calls): a
+  /// test's actions then happen between its steps, at exact simulated times.
+  void Drive();
+  void Undrive();
+  bool Driven() const { return drives_ > 0; }
+  /// Runs time from now up to `until` and then calls `done(woken)` between rounds: at `until`, or
+  /// earlier at the end of the round in which Wake() was called (something reached the driver: a
+  /// frame for its bus participant, an answer to its control request). While time is held
+  /// (Hold(), nodes still joining) it waits. Only while Driven(); one at a time.
+  /// @throws std::logic_error when not driven or another Advance runs
+  void Advance(TimePoint until, std::function<void(bool woken)> done);
+  /// Ends the running Advance at the end of the current round (nothing when none runs).
+  void Wake() {
+    if (advance_done_) advance_woken_ = true;
+  }
+  bool Advancing() const { return static_cast<bool>(advance_done_); }
+
   TimePoint Now() const { return scheduler_.Now(); }
   /// Achieved factor (simulated / real time) while running; 0 before any round.
   double Factor() const;
@@ -160,6 +178,10 @@ class TimeConductor {
   /// Forgets processes whose every session left (and the frames they still had to go).
   void Prune();
   void OnGraceExpired();
+  /// Driven: whether the running Advance stops now (it then calls its `done`); true also when no
+  /// Advance runs (time stands still).
+  bool AdvanceStops();
+  void FinishAdvance();
   /// The grace timer, for the open round's deadline `at` (real time).
   void ArmGrace(std::chrono::steady_clock::time_point at);
 
@@ -189,6 +211,10 @@ class TimeConductor {
   TimePoint round_until_{};
   std::size_t outstanding_ = 0;
   int holds_ = 0;
+  int drives_ = 0;
+  TimePoint advance_until_{};
+  std::function<void(bool)> advance_done_;  ///< set while an Advance runs
+  bool advance_woken_ = false;
 
   // Pacing and the achieved factor: real and simulated time since running started.
   /// Running since (real, simulated); reset when time stood still (held, idle, no node).

@@ -18,8 +18,10 @@ not through socketcand:
 
 Threading: one reader thread per bus decodes what the broker sends (frames into the inbox,
 controller events, pings, node requests); send() writes from the caller's thread under a lock.
-recv() waits on the inbox. In real time these waits are wall-clock waits; python/README.md
-("Virtual time: the plan") says how the same waits move to simulated time.
+recv() waits on the inbox. In real time these waits are wall-clock waits; on a fleet this process
+drives in virtual time (Fleet.up(time="virtual")) the bus joins as a *driven* participant
+(Hello.driven) and its waits count simulated seconds on the fleet's clock (canfleet/clock.py,
+python/README.md "Virtual time").
 """
 from __future__ import annotations
 
@@ -29,12 +31,15 @@ import os
 import socket
 import threading
 import time
-from typing import Any, Deque, List, Optional, Tuple
+from typing import Any, Deque, Dict, List, Optional, Tuple
 
 import can
 from can import BusState, CanInitializationError, CanOperationError
 
 from . import endpoints, wire
+from .clock import Clock
+from .sim_periodic import SimCyclicSendTask
+from .virtual import SimCondition
 from ._proto import wire as pb
 from .errors import BrokerRefusedError, CanfleetError, WireVersionError
 from .framing import DelimitedReader, FramingError
@@ -70,11 +75,12 @@ def acceptance_ids(filters: Optional[List[Any]]) -> Optional[List[int]]:
 
 class _Inbox:
     """Received messages, waited for by recv(). The one place a Python thread waits for the bus:
-    in virtual time this wait is the one that moves to simulated time (python/README.md)."""
+    on a driven fleet (`clock`) it waits in simulated time (python/README.md, "Virtual time")."""
 
-    def __init__(self) -> None:
+    def __init__(self, clock: Optional[Clock] = None) -> None:
         self._items: Deque[can.Message] = collections.deque()
-        self._cond = threading.Condition()
+        self._cond = SimCondition() if clock is not None else threading.Condition()
+        self._clock = clock
         self._closed: Optional[str] = None
 
     def put(self, items: List[can.Message]) -> None:
@@ -89,6 +95,8 @@ class _Inbox:
             self._cond.notify_all()
 
     def get(self, timeout: Optional[float]) -> Optional[can.Message]:
+        if self._clock is not None:
+            return self._get_simulated(timeout)
         deadline = None if timeout is None else time.monotonic() + timeout
         with self._cond:
             while not self._items:
@@ -98,6 +106,24 @@ class _Inbox:
                 if left is not None and left <= 0:
                     return None
                 self._cond.wait(left)
+            return self._items.popleft()
+
+    def _get_simulated(self, timeout: Optional[float]) -> Optional[can.Message]:
+        clock = self._clock
+        assert clock is not None
+        deadline = clock.deadline_ns(timeout)
+        with self._cond:
+            while not self._items:
+                if self._closed is not None:
+                    raise CanOperationError(self._closed)
+                if deadline is not None and clock.now_ns >= deadline:
+                    return None
+                try:
+                    self._cond.wait(None if deadline is None else (deadline - clock.now_ns) / 1e9)
+                except CanfleetError as e:  # the fleet went away: python-can's error for a lost bus
+                    raise CanOperationError(str(e)) from None
+                if clock.consume_interrupt():
+                    return None
             return self._items.popleft()
 
 
@@ -127,11 +153,15 @@ class CanfleetBus(can.BusABC):
         self.channel = channel
         self.channel_info = f"canfleet bus {channel}"
         self.name = name or f"python-can-{os.getpid()}-{next(_names)}"
-        self.endpoint = _broker_endpoint(broker, fleet)
+        self.endpoint, fleet = _broker_endpoint(broker, fleet)
+        #: The driven fleet's simulated clock (virtual time), else None: waits are real-time waits.
+        self.clock: Optional[Clock] = fleet.clock if fleet is not None else None
         self.receive_own_messages = receive_own_messages
         self._send_lock = threading.Lock()
-        self._inbox = _Inbox()
-        self._state_cond = threading.Condition()
+        self._inbox = _Inbox(self.clock)
+        self._state_cond = SimCondition() if self.clock is not None else threading.Condition()
+        self._pongs: Dict[int, threading.Event] = {}
+        self._nonces = itertools.count(1)
         self._state = BusState.ACTIVE
         self.tec = 0
         self.rec = 0
@@ -155,12 +185,14 @@ class CanfleetBus(can.BusABC):
         self._thread = threading.Thread(target=self._read_loop, name=f"canfleet-bus-{self.name}", daemon=True)
         self._thread.start()
         super().__init__(channel=channel, can_filters=can_filters, **kwargs)
+        if self.clock is not None:
+            self.clock.add_bus(self)
 
     # -- connecting ----------------------------------------------------------------------------
     def _hello(self, bitrate: int, timeout: float) -> pb.HelloReply:
         hello = pb.Hello(protocol_version=wire.PROTOCOL_VERSION, bus=self.channel, node_name=self.name,
                          node_id=0, role=pb.ROLE_NODE, tx_confirmations=self.receive_own_messages,
-                         bitrate=bitrate)
+                         bitrate=bitrate, virtual_time=self.clock is not None, driven=self.clock is not None)
         self._sock.sendall(wire.envelope(hello=hello))
         deadline = time.monotonic() + timeout
         while True:
@@ -218,6 +250,45 @@ class CanfleetBus(can.BusABC):
             except OSError as e:
                 raise CanOperationError(f"canfleet: broker connection lost ({e})") from None
 
+    def recv(self, timeout: Optional[float] = None) -> Optional[can.Message]:
+        """python-can's recv; on a driven fleet `timeout` is simulated seconds, also across frames
+        the filters reject (python-can's own loop counts those in real time)."""
+        clock = self.clock
+        if clock is None:
+            return super().recv(timeout)
+        deadline = clock.deadline_ns(timeout)
+        while True:
+            left = None if deadline is None else max(0, deadline - clock.now_ns) / 1e9
+            msg = self._inbox.get(left)
+            if msg is None:
+                return None
+            if self._matches_filters(msg):
+                return msg
+
+    def _send_periodic_internal(self, msgs: Any, period: float, duration: Optional[float] = None,
+                                autostart: bool = True, modifier_callback: Any = None) -> Any:
+        if self.clock is None:
+            return super()._send_periodic_internal(msgs, period, duration, autostart, modifier_callback)
+        return SimCyclicSendTask(self, self.clock, msgs, period, duration, autostart, modifier_callback)
+
+    def _sync(self) -> None:
+        """Ping and wait for the Pong: the broker has read everything sent before, and the reader
+        thread has handled everything the broker sent before (the clock's barrier, real time)."""
+        if self._closing:
+            return
+        nonce = next(self._nonces)
+        done = threading.Event()
+        self._pongs[nonce] = done
+        try:
+            self._write(wire.envelope(ping=pb.Ping(nonce=nonce)))
+            while not done.wait(0.05):
+                if self._closing or not self._thread.is_alive():
+                    return
+        except CanOperationError:
+            return
+        finally:
+            self._pongs.pop(nonce, None)
+
     def _recv_internal(self, timeout: Optional[float]) -> Tuple[Optional[can.Message], bool]:
         # Never "already filtered": extended and error frames pass the broker, so python-can checks
         # every frame against the filters as well.
@@ -248,7 +319,7 @@ class CanfleetBus(can.BusABC):
     def wait_for_state(self, state: BusState, timeout: float) -> bool:
         """Waits until the controller is in `state`; False when `timeout` (seconds) passed first."""
         with self._state_cond:
-            return self._state_cond.wait_for(lambda: self._state is state, timeout)
+            return bool(self._state_cond.wait_for(lambda: self._state is state, timeout))
 
     def shutdown(self) -> None:
         if self._closing:
@@ -259,6 +330,8 @@ class CanfleetBus(can.BusABC):
                 self._sock.shutdown(socket.SHUT_RDWR)
             except OSError:
                 pass
+        if self.clock is not None:
+            self.clock.remove_bus(self)
         self._thread.join(timeout=5)
         self._sock.close()
         self._inbox.close("canfleet: the bus is shut down")
@@ -311,6 +384,10 @@ class CanfleetBus(can.BusABC):
                 self._state_cond.notify_all()
         elif kind == "ping":
             self._write_quietly(wire.envelope(pong=pb.Pong(nonce=env.ping.nonce)))
+        elif kind == "pong":
+            done = self._pongs.get(env.pong.nonce)
+            if done is not None:
+                done.set()
         elif kind == "node_request":
             reply = pb.NodeReply(request_id=env.node_request.request_id,
                                  error=f"{self.name} is a python-can participant: it has no simulated I/O")
@@ -318,7 +395,7 @@ class CanfleetBus(can.BusABC):
         elif kind == "error":
             return f"canfleet: the broker closed the connection: {env.error.reason}"
         elif kind == "time_grant":
-            return "canfleet: a time grant on a real-time participant (virtual time is not supported yet)"
+            return "canfleet: a time grant to a driven participant (it is never granted time): protocol error"
         return None
 
     def _write_quietly(self, payload: bytes) -> None:
@@ -335,20 +412,23 @@ class CanfleetBus(can.BusABC):
             is_rx=rx, check=False)
 
 
-def _broker_endpoint(broker: Optional[str], fleet: Optional[Any]) -> str:
-    if broker:
-        return broker
+def _broker_endpoint(broker: Optional[str], fleet: Optional[Any]) -> Tuple[str, Optional[Any]]:
+    """The broker's endpoint, and the fleet it belongs to when known (its clock, in virtual time)."""
     if fleet is None:
         from .fleet import current
         fleet = current()
+        if fleet is not None and broker and str(fleet.broker) != broker:
+            fleet = None  # another fleet's broker
+    if broker:
+        return broker, fleet
     if fleet is not None:
         if not fleet.broker:
             raise CanInitializationError("canfleet: this fleet was attached without its broker endpoint "
                                          "(Fleet.attach(control, broker=...))")
-        return str(fleet.broker)
+        return str(fleet.broker), fleet
     env = os.environ.get("CANFLEET_BROKER")
     if env:
-        return env
+        return env, None
     raise CanInitializationError("canfleet: which fleet? pass broker='tcp://HOST:PORT' or fleet=..., run inside "
                                  "`with Fleet.up(...)`, or set CANFLEET_BROKER")
 

@@ -25,9 +25,11 @@ import time as _time
 import weakref
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Dict, List, Literal, Mapping, Optional, Union
+from typing import Any, Callable, Dict, List, Literal, Mapping, Optional, Union
 
-from . import process
+from . import process, virtual
+from . import clock as clock_module
+from .clock import Clock
 from ._proto import control as pb
 from .control import ControlClient
 from .errors import (CanfleetError, FleetStartError, NodeDiedError, NotReachableError, OrchestratorError,
@@ -330,6 +332,10 @@ class Fleet:
         #: keeps it when a test failed, so the paths in its report stay valid.
         self.remove_state_at_close = False
         self.captures: List[Capture] = []
+        #: Virtual time driven by this process (Fleet.up(time="virtual"), or attached to a fleet
+        #: started with `canfleet up --driven`): the fleet's simulated clock. None in real time.
+        self.clock: Optional[Clock] = None
+        self._owns_clock = False
         self._proc: Optional["subprocess.Popen[bytes]"] = None
         self._log_file: Optional[Any] = None
         self._restarts: Dict[str, int] = {}
@@ -350,8 +356,23 @@ class Fleet:
             fleet.close()
             raise
         fleet.time = "virtual" if status.virtual_time else "real"
+        try:
+            if status.driven:
+                fleet._drive(status)
+        except BaseException:
+            fleet.close()
+            raise
         fleet._baseline(status)
         return fleet
+
+    def _drive(self, status: pb.Status) -> None:
+        virtual.install()
+        existing = clock_module.active()
+        if existing is not None and existing.control == self.control:
+            self.clock = existing  # this process drives it already (another Fleet object): one clock
+            return
+        self.clock = Clock(self.control, status.now_ns, self.client.timeout)
+        self._owns_clock = True
 
     @classmethod
     def up(cls, topology: Union[str, Path], *, time: TimeMode = "real", seed: Optional[int] = None,
@@ -361,8 +382,9 @@ class Fleet:
         """Starts the fleet of `topology` on private endpoints (control on a free TCP port, nodes on a
         Unix socket in its state folder) and returns once every node has booted and been configured.
 
-        - time: "real", or "virtual" (the broker owns the clock; Python taking part in virtual time
-          is the next step, python/README.md).
+        - time: "real", or "virtual": the fleet's time then runs only inside this process's waits
+          (fleet.run, run_until, expect, control requests, python-can recv, python-canopen's
+          timeouts), in simulated seconds, deterministically (python/README.md "Virtual time").
         - seed: seeds the faults that give no seed of their own (the topology's time.seed otherwise).
         - state_dir: node state, logs (orchestrator.log) and captures; default a new temporary
           folder, removed at close.
@@ -398,6 +420,8 @@ class Fleet:
         args = [str(binaries / "canfleet"), "up", str(topology.resolve()), "--ready-file", str(ready),
                 "--control", "tcp://127.0.0.1:0", "--listen", listen, "--state-dir", str(state / "nodes"),
                 "--time", time, "--log-level", log_level]
+        if time == "virtual":
+            args.append("--driven")
         if seed is not None:
             args += ["--seed", str(seed)]
         if not telemetry:
@@ -427,7 +451,10 @@ class Fleet:
         fleet.log_path = log_path
         fleet.remove_state_at_close = owned_state
         try:
-            fleet._baseline(fleet.status())
+            status = fleet.client.call(pb.Request(status=pb.StatusRequest())).status
+            if time == "virtual":
+                fleet._drive(status)
+            fleet._baseline(status)
         except BaseException:
             fleet.close()
             raise
@@ -437,7 +464,84 @@ class Fleet:
     def _call(self, request: pb.Request) -> pb.Response:
         if self.closed:
             raise CanfleetError("this fleet is closed")
+        if self.clock is not None:
+            return self.clock.call(request)
         return self.client.call(request)
+
+    # -- time ----------------------------------------------------------------------------------
+    @property
+    def now(self) -> float:
+        """The fleet's time in seconds: simulated (exact) in virtual time, its uptime in real time."""
+        if self.clock is not None:
+            return self.clock.now
+        return self.status().uptime_s
+
+    def run(self, seconds: float) -> float:
+        """Lets the fleet run `seconds` (simulated in virtual time, exactly; wall-clock in real time)
+        and returns fleet.now. In virtual time other threads of this process that wait (a Notifier,
+        a python-canopen timeout) wake at their own simulated times meanwhile."""
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool) or seconds < 0:
+            raise ValueError(f"seconds={seconds!r}: non-negative seconds")
+        if self.clock is not None:
+            self.clock.sleep(seconds)
+            return self.clock.now
+        _time.sleep(seconds)
+        return self.now
+
+    def run_until(self, predicate: Callable[[], Any], timeout: float, step: float = 0.01) -> Any:
+        """Runs the fleet in steps of `step` seconds until `predicate()` is true (returns its value)
+        or `timeout` seconds passed (returns its last, false value). Simulated seconds in virtual
+        time: the answer is the same on every run."""
+        if timeout < 0 or step <= 0:
+            raise ValueError("timeout must be >= 0 and step > 0 (seconds)")
+        if self.clock is None:
+            end = _time.monotonic() + timeout
+            while not (value := predicate()) and _time.monotonic() < end:
+                _time.sleep(step)
+            return value
+        end_ns = self.clock.deadline_ns(timeout)
+        assert end_ns is not None
+        while not (value := predicate()):
+            left = end_ns - self.clock.now_ns
+            if left <= 0:
+                return value
+            self.clock.sleep(min(step, left / 1e9))
+        return value
+
+    def expect(self, kind: str, *, within: float = 0.0, throughout: bool = False, **fields: Any) -> "Expectation":
+        """Judges an expectation of a scenario's kinds (topologies/README.md "Expectations": emcy,
+        no_emcy, nmt, sdo, io, frames, bus, controller) by the orchestrator's own judges, its window
+        opening now and lasting `within` seconds; returns when it is decided. Fields as the topology
+        file spells them: fleet.expect("emcy", node="quad-5", code=0x8130, within=3.0).
+        ExpectationFailed when it failed (with what was seen instead); the Expectation (outcome,
+        what was seen and when) when it passed."""
+        if not re.fullmatch(r"[a-z_]+", kind):
+            raise ValueError(f"kind={kind!r}: emcy, no_emcy, nmt, sdo, io, frames, bus or controller")
+        if within < 0:
+            raise ValueError(f"within={within!r}: non-negative seconds")
+        text = f"{kind} {{ {_text_fields(fields)} }} within_ms: {round(within * 1000)}"
+        if throughout:
+            text += " throughout: true"
+        return self.expect_text(text)
+
+    def expect_text(self, text: str) -> "Expectation":
+        """fleet.expect with the expectation in the topology's text format:
+        'emcy { node: "quad-5" code: 0x8130 } within_ms: 3000'."""
+        if self.clock is None:
+            window = re.search(r"within_ms:\s*(\d+)", text)
+            timeout = (int(window.group(1)) / 1000 if window else 0) * 2 + self.client.timeout
+            response = self.client.call(pb.Request(expect=pb.ExpectRequest(expect=text)), timeout=timeout)
+        else:
+            response = self._call(pb.Request(expect=pb.ExpectRequest(expect=text)))
+            # What was seen ends a little after the judge heard it begin (a frame's end-of-frame
+            # time): return once the fleet is there, so that fleet.now >= result.decided.
+            ahead = response.expect.decided_ns - self.clock.now_ns
+            if ahead > 0:
+                self.clock.sleep(ahead / 1e9)
+        result = Expectation(response.expect)
+        if result.outcome == "FAIL":
+            raise ExpectationFailed(result)
+        return result
 
     def status(self) -> pb.Status:
         """Buses, nodes (process, NMT state, controller, TEC/REC, heartbeat age, last EMCY) and the
@@ -560,6 +664,8 @@ class Fleet:
                         capture.stop()
                     except CanfleetError:
                         pass
+            if self.clock is not None and self._owns_clock:
+                self.clock.close()
             if self._proc is not None:
                 _stop_process(self._proc, self.client)
         finally:
@@ -587,6 +693,59 @@ class Fleet:
 
     def __repr__(self) -> str:
         return f"<Fleet {self.topology or ''} control={self.control}{' closed' if self.closed else ''}>"
+
+
+@dataclass(frozen=True)
+class Expectation:
+    """A decided expectation (Fleet.expect): outcome "pass", "FAIL" or "skip", what it judged, what
+    was seen (or seen instead, or why it was not judged), and when (fleet seconds)."""
+    outcome: str
+    description: str
+    detail: str
+    opened: float
+    decided: float
+
+    def __init__(self, result: pb.ExpectResult) -> None:
+        object.__setattr__(self, "outcome", result.outcome)
+        object.__setattr__(self, "description", result.description)
+        object.__setattr__(self, "detail", result.detail)
+        object.__setattr__(self, "opened", result.opened_ns / 1e9)
+        object.__setattr__(self, "decided", result.decided_ns / 1e9)
+
+    @property
+    def passed(self) -> bool:
+        return self.outcome == "pass"
+
+
+class ExpectationFailed(CanfleetError, AssertionError):
+    """Fleet.expect judged FAIL: the message says what was expected and what was seen instead."""
+
+    def __init__(self, result: Expectation) -> None:
+        super().__init__(f"expected {result.description}: {result.detail} (window opened at "
+                         f"t={result.opened:.6f} s, decided at t={result.decided:.6f} s)")
+        self.result = result
+
+
+def _text_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    raise TypeError(f"{value!r}: a str, int, float or bool")
+
+
+def _text_fields(fields: Mapping[str, Any]) -> str:
+    parts = []
+    for name, value in fields.items():
+        if not re.fullmatch(r"[a-z_]+", name):
+            raise ValueError(f"{name!r}: not a field name")
+        for v in value if isinstance(value, (list, tuple)) else [value]:
+            parts.append(f"{name}: {_text_value(v)}")
+    return " ".join(parts)
 
 
 def _read_ready(path: Path) -> Dict[str, str]:

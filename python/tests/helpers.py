@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Callable, Iterable, List, Optional, TypeVar
 
 import canfleet
+import canfleet.clock
 
 T = TypeVar("T")
 
@@ -31,6 +32,16 @@ def quad_eds() -> Path:
 
 def wait_until(predicate: Callable[[], Optional[T]], timeout: float = WAIT, step: float = 0.02) -> Optional[T]:
     """Polls predicate until it returns something truthy (returned) or `timeout` passed (None)."""
+    clock = canfleet.clock.active()
+    if clock is not None:  # a driven fleet: simulated seconds, the same answer on every run
+        end = clock.now + timeout
+        while True:
+            value = predicate()
+            if value:
+                return value
+            if clock.now > end:
+                return None
+            clock.sleep(step)
     deadline = time.monotonic() + timeout
     while True:
         value = predicate()
@@ -45,6 +56,14 @@ def observe_absence(seen: Callable[[], list], window: float, reason: str) -> lis
     """Watches for something that must NOT happen for `window` seconds (`reason` says why that is
     long enough); returns what `seen` reported, at the first sighting or at the window's end."""
     assert reason, "state why the window is long enough"
+    clock = canfleet.clock.active()
+    if clock is not None:  # the window in simulated seconds
+        end = clock.now + window
+        while True:
+            found = seen()
+            if found or clock.now >= end:
+                return found
+            clock.sleep(min(0.02, max(end - clock.now, 1e-9)))
     deadline = time.monotonic() + window
     while True:
         found = seen()

@@ -26,8 +26,8 @@ def bin_dir(request) -> Path:
 
 
 @pytest.fixture(scope="session")
-def fleet(bin_dir, tmp_path_factory):
-    f = Fleet(bin_dir, tmp_path_factory.mktemp("fleet"), VARIANTS)
+def fleet(bin_dir, tmp_path_factory, request):
+    f = Fleet(bin_dir, tmp_path_factory.mktemp("fleet"), VARIANTS, request.config.getoption("--canfleet-time"))
     yield f
     f.stop()
 

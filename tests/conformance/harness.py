@@ -1,6 +1,14 @@
 """Processes and connections for the conformance suite: one `canfleet up` fleet per session, one
-fresh `canfleet-node` per test, python-canopen joining the bus through the fleet's socketcand
-endpoint.
+fresh `canfleet-node` per test, python-canopen joining the bus through the canfleet python-can
+interface (the node wire protocol: canfleet/can_bus.py), in virtual or real time
+(--canfleet-time, from the canfleet pytest plugin; run.sh makes virtual the default).
+
+In virtual time the fleet is driven by this process (`canfleet up --time virtual --driven
+--no-start`, attached with canfleet.Fleet.attach): its time runs only while the test waits, so
+SDO timeouts, boot-up waits and absence windows are simulated seconds, and python-canopen's own
+waits move to simulated time (canfleet.virtual). Every request to the fleet (simulated I/O,
+status) goes through canfleet.Fleet, the one client that keeps time with the test: a `canfleet`
+CLI process would wait on the wall clock for answers the stopped fleet cannot give.
 
 The fleet's topology (written here) has one bus with a socketcand endpoint and one `external`
 node per variant, and `start_nodes: false` with no heartbeat or SDO configuration: the
@@ -22,6 +30,9 @@ from typing import Callable, List, Optional
 import can
 import canopen
 
+import canfleet
+import canfleet.clock
+
 # Generous bounds: they only stop a test that would otherwise hang, nothing is asserted on them.
 STARTUP_TIMEOUT = 60.0
 BOOT_TIMEOUT = 30.0
@@ -31,35 +42,49 @@ WAIT_TIMEOUT = 30.0
 FACTORY_BITRATE = 125_000
 
 
+def _now() -> float:
+    """The fleet's clock: simulated seconds when this process drives it, else the wall clock."""
+    clock = canfleet.clock.active()
+    return clock.now if clock is not None else time.monotonic()
+
+
+def _sleep(seconds: float) -> None:
+    clock = canfleet.clock.active()
+    if clock is not None:
+        clock.sleep(seconds)
+    else:
+        time.sleep(seconds)
+
+
 def wait_until(predicate: Callable[[], object], timeout: float = WAIT_TIMEOUT, step: float = 0.05):
     """Polls predicate until it returns something truthy (returned) or timeout (returns None)."""
-    deadline = time.monotonic() + timeout
+    deadline = _now() + timeout
     while True:
         value = predicate()
         if value:
             return value
-        if time.monotonic() > deadline:
+        if _now() > deadline:
             return None
-        time.sleep(step)
+        _sleep(step)
 
 
 def observe_absence(seen: Callable[[], list], window: float, reason: str) -> list:
     """Watches for something that must NOT happen, for a bounded observation window; returns what
     `seen` reported (the caller asserts it is empty), at the first sighting or at the window's end.
 
-    No event says "never": proving that a frame was not sent takes watching the bus for a while,
-    which is real time. `window` (seconds) is that while, and `reason` says why it is long enough
+    No event says "never": proving that a frame was not sent takes watching the bus for a while
+    (simulated time in virtual time, real time otherwise). `window` (seconds) is that while, and `reason` says why it is long enough
     for this claim (e.g. "20 periods of the former 50 ms heartbeat"), so that nobody shortens it
     below what the claim needs or mistakes it for a wait on something that happens.
     """
     assert reason, "state why the window is long enough"
-    deadline = time.monotonic() + window
+    deadline = _now() + window
     while True:
         found = seen()
-        left = deadline - time.monotonic()
+        left = deadline - _now()
         if found or left <= 0:
             return found
-        time.sleep(min(0.05, left))
+        _sleep(min(0.05, left))
 
 
 def free_tcp_port() -> int:
@@ -79,10 +104,13 @@ def tail(path: Path, lines: int = 40) -> str:
 class Fleet:
     """`canfleet up` with a generated topology, until stop()."""
 
-    def __init__(self, bin_dir: Path, work: Path, variants):
+    def __init__(self, bin_dir: Path, work: Path, variants, time_mode: str = "virtual"):
         self.bin_dir = bin_dir
         self.work = work
-        self.socketcand_port = free_tcp_port()
+        self.virtual = time_mode == "virtual"
+        # socketcand lives in real time (refused on a virtual bus); the real-time suite keeps it
+        # so that python-can's own socketcand interface keeps a test.
+        self.socketcand_port = 0 if self.virtual else free_tcp_port()
         self.bus = "can0"
         self.topology = work / "conformance.textproto"
         self.topology.write_text(self._topology(variants))
@@ -94,16 +122,22 @@ class Fleet:
         self.proc = subprocess.Popen(
             [str(bin_dir / "canfleet"), "up", str(self.topology), "--ready-file", str(self.ready_file),
              "--control", "tcp://127.0.0.1:0", "--listen", "tcp://127.0.0.1:0", "--no-start",
-             "--log-level", "debug"],
+             "--log-level", "debug", "--time", time_mode, *(["--driven"] if self.virtual else [])],
             stdout=self._log_file, stderr=subprocess.STDOUT, env=env, start_new_session=True)
         self.control = ""
         self.broker = ""
+        self.api: Optional[canfleet.Fleet] = None
         ok = wait_until(self._read_ready, STARTUP_TIMEOUT)
         if not ok:
             self.stop()
             raise RuntimeError(f"canfleet up did not write its endpoints to {self.ready_file}:\n{tail(self.log)}")
+        # The one client of the fleet: in virtual time it holds the fleet's clock.
+        self.api = canfleet.Fleet.attach(self.control, broker=self.broker)
+        if self.virtual and self.api.clock is None:
+            self.stop()
+            raise RuntimeError(f"the fleet is not driven by this process:\n{tail(self.log)}")
         # The socketcand endpoint is up once the orchestrator is: wait until it accepts.
-        if not wait_until(self._socketcand_accepts, STARTUP_TIMEOUT):
+        if not self.virtual and not wait_until(self._socketcand_accepts, STARTUP_TIMEOUT):
             self.stop()
             raise RuntimeError(f"no socketcand endpoint on port {self.socketcand_port}:\n{tail(self.log)}")
 
@@ -116,7 +150,8 @@ class Fleet:
             # The variants' factory bit rate (every manual: 125 kbit/s): a node nobody configured is
             # commissioned for its bus, so 5B50h (the bit rate, UMAX020411A §3.4.110) reads its EDS
             # default only on a bus at the factory rate, as a device fresh from the factory would.
-            f'bus {{ name: "{self.bus}" bitrate: {FACTORY_BITRATE} socketcand_port: {self.socketcand_port} }}',
+            f'bus {{ name: "{self.bus}" bitrate: {FACTORY_BITRATE}'
+            + (f" socketcand_port: {self.socketcand_port}" if self.socketcand_port else "") + " }",
         ]
         # A device with several CAN ports has its port 1 on can0 (python-canopen's bus) and each
         # further port on a bus of its own (can1, ...) without a socketcand endpoint: the suite
@@ -162,9 +197,22 @@ class Fleet:
         return result
 
     def io_get(self, node: str, name: str) -> str:
-        return self.cli("io", "get", node, name).stdout.strip()
+        assert self.api is not None
+        return self.api.node(node).io_get(name).value
+
+    def io_set(self, node: str, name: str, value: str) -> None:
+        assert self.api is not None
+        self.api.node(node).io_set(name, value)
+
+    def attached(self, node: str) -> bool:
+        """The orchestrator's view: the (external) node has a broker connection on every port."""
+        assert self.api is not None
+        return any(n.name == node and n.attached for n in self.api.status().nodes)
 
     def stop(self) -> None:
+        if self.api is not None:
+            self.api.close()  # attached: disconnects (and lets go of the clock)
+            self.api = None
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGTERM)
             try:
@@ -213,8 +261,12 @@ class NodeUnderTest:
         self.proc: Optional[subprocess.Popen] = None
         self.frames = Frames()
         self.network = canopen.Network()
-        self.network.connect(interface="socketcand", host="127.0.0.1", port=fleet.socketcand_port,
-                             channel=fleet.bus)
+        if fleet.socketcand_port:
+            self.network.connect(interface="socketcand", host="127.0.0.1", port=fleet.socketcand_port,
+                                 channel=fleet.bus)
+        else:
+            self.network.connect(interface="canfleet", channel=fleet.bus, fleet=fleet.api,
+                                 name=f"python-canopen-{variant.name}")
         self.network.notifier.add_listener(self.frames)
         self.network.lss.RESPONSE_TIMEOUT = SDO_TIMEOUT
         self.remote = self.add_remote(self.node_id)
@@ -231,6 +283,8 @@ class NodeUnderTest:
         for port in range(self.variant.ports):
             cmd += ["--bus", f"{self.fleet.port_bus(port)}@{self.fleet.broker}"]
         cmd += ["--state-dir", str(self.state_dir), "--no-telemetry", "--log-level", "debug"]
+        if self.fleet.virtual:
+            cmd += ["--time", "virtual"]
         for io in self.variant.default_io:
             cmd += ["--io", io]
         return cmd + self.extra_args

@@ -3,7 +3,9 @@
 #
 # Usage: tests/conformance/run.sh [BUILD_DIR] [PYTEST_ARGS...]
 #   BUILD_DIR   CMake build folder whose bin/ has canfleet and canfleet-node (default: build)
-#   PYTEST_ARGS passed on, e.g. -k quad-controller, -x, -v
+#   PYTEST_ARGS passed on, e.g. -k quad-controller, -x, -v; --canfleet-time real runs the suite
+#               in real time over socketcand (default: virtual time, python-canopen on the
+#               canfleet interface)
 #
 # Creates/uses the project venv (scripts/python-env.sh: pinned python-can, canopen, pytest), then
 # runs pytest. Exit codes: 0 every check passed; 1 a check failed; 2 usage or missing binaries;
@@ -24,4 +26,10 @@ python_suite_setup "conformance" "$build"
 cd "$here"
 echo "conformance: $("$python" -c 'import canopen, can; print(f"python-canopen {canopen.__version__}, python-can {can.__version__}")'), binaries from $build/bin"
 export CANFLEET_BUILD_DIR="$build"
-exec "$python" -m pytest "--build-dir=$build" "$@"
+# Virtual time unless the arguments say otherwise (--canfleet-time real: the wall-clock suite,
+# python-canopen over socketcand).
+time_mode=(--canfleet-time virtual)
+for arg in "$@"; do
+  case "$arg" in --canfleet-time*) time_mode=() ;; esac
+done
+exec "$python" -m pytest "--build-dir=$build" "${time_mode[@]}" "$@"

@@ -21,12 +21,11 @@ def lss_supported(variant) -> bool:
 
 
 def attached(node) -> bool:
-    """The orchestrator's view (canfleet status --json): the external node has a broker connection.
+    """The orchestrator's view (its status): the external node has a broker connection.
     A refused connection (see the node's log) fails at once instead of waiting."""
     if "refused" in node.log.read_text(errors="replace"):
         raise AssertionError(f"the broker refused the node:\n{tail(node.log, 3)}")
-    status = json.loads(node.fleet.cli("status", "--json").stdout)
-    return any(n.get("name") == node.variant.name and n.get("attached") for n in status.get("nodes", []))
+    return node.fleet.attached(node.variant.name)
 
 
 @pytest.fixture

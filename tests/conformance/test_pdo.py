@@ -48,7 +48,7 @@ def test_tpdos_decode_after_nmt_start(node, variant, fleet):
     what SDO reads from the same objects, and the inputs the variant sets."""
     remote = node.remote
     for signal, value in variant.pdo_io:
-        fleet.cli("io", "set", variant.name, signal, value)
+        fleet.io_set(variant.name, signal, value)
     remote.tpdo.read()
     periodic = {n: p for n, p in remote.tpdo.items() if p.enabled and p.event_timer}
     assert periodic, "no valid TPDO with an event timer"

@@ -70,18 +70,18 @@ class Variant:
 
 def _io_set(signal: str, value: str):
     def run(fleet, node):
-        fleet.cli("io", "set", node.variant.name, signal, value)
+        fleet.io_set(node.variant.name, signal, value)
     return run
 
 
-def _fault_inject(*args: str):
+def _fault_inject(kind: str):
     def run(fleet, node):
-        fleet.cli("fault", "inject", *args, "--node", node.variant.name, "--label", "conformance")
+        fleet.api.inject(kind, node=node.variant.name, label="conformance")
     return run
 
 
 def _fault_clear(fleet, node):
-    fleet.cli("fault", "clear", "--label", "conformance")
+    fleet.api.clear_faults()
 
 
 # Quad (AX020506 manual V2.02, §4.1): the channel byte then the description byte follow the code;

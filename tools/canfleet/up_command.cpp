@@ -21,6 +21,7 @@ struct UpArgs {
   std::string ready_file;
   std::string log_level = "info";
   bool no_start = false;
+  bool driven = false;
   bool telemetry = true;
   std::string time;       ///< "" = the topology's
   std::string speed;      ///< "" = the topology's
@@ -39,6 +40,7 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.ready_file = args.ready_file;
   options.log_level = args.log_level;
   options.no_start = args.no_start;
+  options.driven = args.driven;
   options.telemetry = args.telemetry;
   options.dds = args.dds;
   options.time.mode = args.time;
@@ -116,6 +118,10 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
       "--speed", args->speed,
       "Virtual time: max (as fast as the processes go) or simulated seconds per real second, e.g. 10 "
       "(default: the topology's time.speed, else max)");
+  up->add_flag("--driven", args->driven,
+               "Virtual time: once the fleet is ready (with --no-start: from time 0) its time runs only "
+               "when a client advances it (the control API's ClockAdvance; python/canfleet's fleet.run, "
+               "bus waits and expectations)");
   up->add_option("--state-dir", args->state_dir,
                  "Folder for the nodes' state and logs, instead of the topology's state_root (a private "
                  "fleet: tests, python/canfleet)");
