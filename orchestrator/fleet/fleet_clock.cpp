@@ -5,25 +5,13 @@
 
 #include <asio/post.hpp>
 
+#include "orchestrator/fleet/control_replies.hpp"
 #include "orchestrator/fleet/fleet.hpp"
 #include "orchestrator/scenario/judge.hpp"
 
 namespace canfleet::fleet {
 
 namespace {
-
-control::Response Answer(const control::Request& request) {
-  control::Response response;
-  response.set_id(request.id());
-  return response;
-}
-
-control::Response Refusal(const control::Request& request, const std::string& error) {
-  control::Response response = Answer(request);
-  response.set_error(error);
-  response.set_bad_request(true);
-  return response;
-}
 
 std::int64_t Ns(TimePoint t) {
   return t.time_since_epoch().count();
@@ -34,18 +22,20 @@ std::int64_t Ns(TimePoint t) {
 void Fleet::AdvanceClock(const control::Request& request, std::shared_ptr<control::Responder> responder) {
   transport::TimeConductor* conductor = options_.conductor;
   if (conductor == nullptr || !conductor->Driven()) {
-    responder->Send(Refusal(request, conductor == nullptr
-                                         ? "this fleet runs in real time: there is no clock to advance"
-                                         : "this fleet's virtual time runs on its own (started without "
-                                           "--driven, or not ready yet): nothing to advance"));
+    responder->Send(Failed(request,
+                           conductor == nullptr
+                               ? "this fleet runs in real time: there is no clock to advance"
+                               : "this fleet's virtual time runs on its own (started without "
+                                 "--driven, or not ready yet): nothing to advance",
+                           true));
     return;
   }
   if (conductor->Advancing()) {
-    responder->Send(Refusal(request, "the clock is already advancing (one driver at a time)"));
+    responder->Send(Failed(request, "the clock is already advancing (one driver at a time)"));
     return;
   }
   const auto reply = [request, responder, conductor](bool woken) {
-    control::Response response = Answer(request);
+    control::Response response = Reply(request);
     response.mutable_clock()->set_now_ns(Ns(conductor->Now()));
     response.mutable_clock()->set_woken(woken);
     responder->Send(response);
@@ -63,11 +53,12 @@ void Fleet::StartExpect(const control::Request& request, std::shared_ptr<control
   pb::TextFormat::Parser parser;
   if (!parser.ParseFromString(request.expect().expect(), &expect))
     return responder->Send(
-        Refusal(request, "expect: not an Expect in text format: " + request.expect().expect()));
+        Failed(request, "expect: not an Expect in text format: " + request.expect().expect(), true));
   if (!expect.after().empty())
-    return responder->Send(Refusal(request,
-                                   "expect: `after` names a scenario step; an asked expectation "
-                                   "opens when it is asked"));
+    return responder->Send(Failed(request,
+                                  "expect: `after` names a scenario step; an asked expectation "
+                                  "opens when it is asked",
+                                  true));
   // The fleet's topology with this one step as its scenario, loaded as a file is: names, ports and
   // values are checked, `can:` numbered, defaults applied, exactly as in a scenario.
   topology::Topology spec = options_.topology;
@@ -83,7 +74,7 @@ void Fleet::StartExpect(const control::Request& request, std::shared_ptr<control
     // The location is in the text made here, not the user's: keep what it says.
     std::string what = e.what();
     if (const auto at = what.find(": scenario"); at != std::string::npos) what = what.substr(at + 2);
-    return responder->Send(Refusal(request, "expect: " + what));
+    return responder->Send(Failed(request, "expect: " + what, true));
   }
   const std::uint64_t id = next_asked_++;
   AskedExpectation& a = *asked;
@@ -93,7 +84,7 @@ void Fleet::StartExpect(const control::Request& request, std::shared_ptr<control
           .act = nullptr,
           .decided =
               [this, request, responder, id](const scenario::Result& result) {
-                control::Response response = Answer(request);
+                control::Response response = Reply(request);
                 control::ExpectResult* r = response.mutable_expect();
                 r->set_outcome(scenario::OutcomeName(result.verdict.outcome));
                 r->set_description(result.description);

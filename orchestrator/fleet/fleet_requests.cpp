@@ -5,32 +5,13 @@
 #include <asio/post.hpp>
 
 #include "orchestrator/control/sdo_value.hpp"
+#include "orchestrator/fleet/control_replies.hpp"
 #include "orchestrator/fleet/fleet.hpp"
 #include "vocabulary/nearest_names.hpp"
 
 namespace canfleet::fleet {
 
 namespace {
-
-control::Response Reply(const control::Request& request) {
-  control::Response response;
-  response.set_id(request.id());
-  return response;
-}
-
-control::Response Failed(const control::Request& request, const std::string& error,
-                         bool bad_request = false) {
-  control::Response response = Reply(request);
-  response.set_error(error);
-  response.set_bad_request(bad_request);
-  return response;
-}
-
-control::Response DoneReply(const control::Request& request, const std::string& detail) {
-  control::Response response = Reply(request);
-  response.mutable_done()->set_detail(detail);
-  return response;
-}
 
 /// Dump subscriptions stay alive while their client is connected.
 struct DumpHolder {

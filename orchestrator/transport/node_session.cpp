@@ -286,7 +286,8 @@ void NodeSession::OnHello(const wire::Hello& hello) {
   if (conductor != nullptr && !hello.virtual_time() && !monitor) {
     Refuse("bus " + hello.bus() +
            " runs in virtual time: a node must run on the broker's clock (canfleet-node --time virtual); "
-           "real-time clients may only watch (monitor role)");
+           "real-time clients may only watch (monitor role); a test's python-can bus joins a fleet its "
+           "test drives (Fleet.up(time='virtual'), canfleet up --driven)");
     return;
   }
   if (hello.driven() && (conductor == nullptr || !conductor->Driven() || !hello.clock_id().empty())) {

@@ -21,8 +21,10 @@ waits (canfleet.virtual) use it.
 from __future__ import annotations
 
 import itertools
+import logging
 import socket
 import threading
+import time
 from typing import Any, Dict, List, Optional, Set
 
 from . import endpoints
@@ -32,6 +34,8 @@ from .framing import DelimitedReader, FramingError, delimited
 
 FOREVER_NS = 1 << 62  # "no deadline": the step runs until something reaches this process
 _POLL_S = 0.05  # real seconds between checks for participant threads that ended without a word
+_STALL_S = 30.0  # real seconds of standing still with waiters before saying which threads hold time
+_log = logging.getLogger("canfleet.clock")
 
 _active: Optional["Clock"] = None
 _active_lock = threading.Lock()
@@ -135,6 +139,7 @@ class Clock:
         (False). Runs the fleet when every participant waits."""
         me = waiter.thread
         self._participants.add(me)
+        since = time.monotonic()
         try:
             while True:
                 if waiter.woken:
@@ -148,6 +153,12 @@ class Clock:
                     self._advance()
                     continue
                 self._cv.wait(_POLL_S)
+                if time.monotonic() - since > _STALL_S and not self._advancing:
+                    since = time.monotonic()
+                    running = sorted(t.name for t in self._participants if t not in self._waiting)
+                    _log.warning("simulated time has stood still for %.0f s: thread(s) %s take part but are not "
+                                 "in a simulated wait (blocked on something else?); see python/README.md "
+                                 "\"Virtual time\"", _STALL_S, ", ".join(running))
         finally:
             self._waiting.pop(me, None)
 

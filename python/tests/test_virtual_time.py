@@ -5,6 +5,7 @@ scripted run byte for byte on an idle and on a loaded machine."""
 from __future__ import annotations
 
 import multiprocessing
+import subprocess
 import time
 from pathlib import Path
 from typing import Callable, List
@@ -14,8 +15,9 @@ import canopen
 import pytest
 
 import canfleet
-from canfleet import ExpectationFailed, Fleet, OrchestratorError
-from helpers import CONFORMANCE_IO_EDS, PAIR, quad_eds
+import canfleet._proto
+from canfleet import BrokerRefusedError, ExpectationFailed, Fleet, OrchestratorError
+from helpers import CONFORMANCE_IO_EDS, PAIR, quad_eds, wait_until
 
 pytestmark = pytest.mark.topology("topologies/pair.textproto", time="virtual")
 
@@ -156,3 +158,25 @@ def test_the_clock_is_the_fleets_and_only_one_per_process(fleet: Fleet) -> None:
     with Fleet.attach(fleet.control, broker=fleet.broker) as again:  # the same fleet: the same clock
         assert again.clock is fleet.clock
         assert again.now == fleet.now
+
+
+def test_a_bus_on_a_virtual_fleet_nobody_drives_is_refused_with_the_reason(tmp_path: Path) -> None:
+    # `canfleet up --time virtual` without --driven: its time runs on its own, as fast as it goes.
+    ready = tmp_path / "ready"
+    proc = subprocess.Popen([str(canfleet.fleet.find_binaries() / "canfleet"), "up", str(PAIR), "--time", "virtual",
+                             "--ready-file", str(ready), "--control", "tcp://127.0.0.1:0", "--listen",
+                             f"unix://{tmp_path / 'broker.sock'}", "--state-dir", str(tmp_path / "nodes"),
+                             "--no-telemetry"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        assert wait_until(lambda: "state ready" in (ready.read_text() if ready.exists() else ""))
+        values = dict(line.split(" ", 1) for line in ready.read_text().splitlines())
+        with Fleet.attach(values["control"], broker=values["broker"]) as fleet:
+            assert fleet.time == "virtual" and fleet.clock is None
+            with pytest.raises(BrokerRefusedError, match="drives"):
+                can.Bus(interface="canfleet", channel="can0", fleet=fleet)
+            with pytest.raises(OrchestratorError, match="runs on its own"):
+                fleet._call(canfleet._proto.control.Request(clock_advance=canfleet._proto.control.ClockAdvance(
+                    until_ns=1)))
+    finally:
+        proc.terminate()
+        proc.wait(timeout=60)

@@ -263,5 +263,91 @@ TEST_F(Conductor, AReplyForAnotherTimeIsRefused) {
   EXPECT_FALSE(a.Reach(std::nullopt)) << "already answered";
 }
 
+// Driven time (python/README.md "Virtual time"): time runs only inside Advance, which stops at its
+// `until` exactly: rounds are capped there, whatever the nodes' deadlines.
+TEST_F(Conductor, DrivenTimeRunsOnlyInsideAnAdvanceAndStopsAtItsEnd) {
+  conductor.Drive();
+  FakeNode a("a", conductor, broker);
+  Poll();
+  EXPECT_TRUE(a.grants.empty()) << "driven: no round before an advance";
+  std::optional<bool> woken;
+  conductor.Advance(TimePoint(300ms), [&](bool w) { woken = w; });
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u);
+  EXPECT_EQ(a.grants[0], std::make_pair(std::int64_t{0}, L));
+  ASSERT_TRUE(a.Reach(500ms));
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u) << "its deadline lies beyond the advance: it stands still";
+  ASSERT_TRUE(woken.has_value());
+  EXPECT_FALSE(*woken);
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), Ns(300ms)) << "the advance ends exactly at its until";
+  EXPECT_FALSE(conductor.Advancing());
+  conductor.Advance(TimePoint(600ms), [&](bool w) { woken = w; });
+  Poll();
+  ASSERT_EQ(a.grants.size(), 2u);
+  EXPECT_EQ(a.grants[1], std::make_pair(Ns(300ms), Ns(500ms) + L));
+  ASSERT_TRUE(a.Reach(1000ms));
+  Poll();
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), Ns(600ms));
+}
+
+// Wake (something reached the driver) ends the advance at the end of the round it came in.
+TEST_F(Conductor, AWakeEndsTheAdvanceAtTheEndOfItsRound) {
+  conductor.Drive();
+  FakeNode a("a", conductor, broker);
+  std::optional<bool> woken;
+  conductor.Advance(TimePoint(10s), [&](bool w) { woken = w; });
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u);
+  conductor.Wake();  // as a frame for a driven participant does, during the round
+  ASSERT_TRUE(a.Reach(500ms));
+  Poll();
+  ASSERT_TRUE(woken.has_value());
+  EXPECT_TRUE(*woken);
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), L) << "stopped where the round ended";
+  EXPECT_EQ(a.grants.size(), 1u);
+}
+
+// With nothing due before its end (no node, no broker timer), an advance gets there at once.
+TEST_F(Conductor, AnAdvanceWithNothingDueJumpsToItsEnd) {
+  conductor.Drive();
+  std::optional<bool> woken;
+  conductor.Advance(TimePoint(2s), [&](bool w) { woken = w; });
+  Poll();
+  ASSERT_TRUE(woken.has_value());
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), Ns(2s));
+}
+
+// An advance waits while time is held (nodes still joining), and only one runs at a time; time
+// that is not driven cannot be advanced.
+TEST_F(Conductor, AnAdvanceWaitsForHoldsAndIsRefusedWhenNotDrivenOrBusy) {
+  EXPECT_THROW(conductor.Advance(TimePoint(1s), [](bool) {}), std::logic_error);
+  conductor.Drive();
+  conductor.Hold();
+  std::optional<bool> woken;
+  conductor.Advance(TimePoint(1s), [&](bool w) { woken = w; });
+  EXPECT_THROW(conductor.Advance(TimePoint(2s), [](bool) {}), std::logic_error);
+  Poll();
+  EXPECT_FALSE(woken.has_value()) << "held";
+  conductor.Release();
+  Poll();
+  ASSERT_TRUE(woken.has_value());
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), Ns(1s));
+}
+
+// Undrive lets time run on its own again (a fleet stopping), and ends a running advance.
+TEST_F(Conductor, UndriveEndsTheAdvanceAndTimeRunsOnItsOwn) {
+  conductor.Drive();
+  conductor.Hold();
+  std::optional<bool> woken;
+  conductor.Advance(TimePoint(1s), [&](bool w) { woken = w; });
+  conductor.Undrive();
+  EXPECT_TRUE(woken.has_value());
+  conductor.Release();
+  FakeNode a("a", conductor, broker);
+  Poll();
+  EXPECT_EQ(a.grants.size(), 1u) << "not driven: rounds run without an advance";
+}
+
 }  // namespace
 }  // namespace canfleet::transport
