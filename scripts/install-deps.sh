@@ -14,7 +14,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config git
-  libasio-dev libspdlog-dev libfmt-dev libcli11-dev zlib1g-dev
+  libasio-dev libspdlog-dev libfmt-dev libcli11-dev zlib1g-dev libboost-dev
   libprotobuf-dev protobuf-compiler
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev
@@ -23,6 +23,7 @@ packages=(
   qemu-system-x86 busybox-static cpio iproute2 xz-utils zstd
   tshark
   debootstrap
+  chromium
 )
 
 # program:package — who calls it
@@ -40,6 +41,7 @@ programs=(
   xz:xz-utils zstd:zstd gzip:gzip                                          # vm-can-test.sh: kernel modules, initramfs
   apt-get:apt apt-cache:apt dpkg-deb:dpkg                                  # vm-can-test.sh: kernel download
   debootstrap:debootstrap                                                  # scripts/docker-base-image.sh
+  chromium:chromium                                                        # tests/system/web: the page in a browser
   timeout:coreutils sha256sum:coreutils mktemp:coreutils awk:mawk sed:sed find:findutils tar:tar flock:util-linux
 )
 

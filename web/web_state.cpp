@@ -1,0 +1,263 @@
+#include "web/web_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "tools/telemetry/event_format.hpp"
+
+namespace canfleet::web {
+
+using tools::JsonString;
+
+namespace {
+
+std::string Number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string Seconds(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+std::string Hex(std::uint32_t v, int digits) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%0*X", digits, v);
+  return buf;
+}
+
+void IoJson(std::ostringstream& out, const std::vector<telemetry::IoValueSample>& values) {
+  out << '[';
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const auto& v = values[i];
+    out << (i ? "," : "") << "{\"name\":" << JsonString(v.name) << ",\"value\":" << Number(v.value)
+        << ",\"unit\":" << JsonString(v.unit) << ",\"text\":" << JsonString(v.text) << '}';
+  }
+  out << ']';
+}
+
+void NodeJson(std::ostringstream& out, const tools::NodeRow& row, tools::WallTime now) {
+  const auto& s = row.status;
+  out << "{\"bus\":" << JsonString(s.bus) << ",\"id\":" << int{s.node_id}
+      << ",\"name\":" << JsonString(s.name) << ",\"device\":" << JsonString(s.device)
+      << ",\"nmt\":" << JsonString(telemetry::StateName(s.nmt_state))
+      << ",\"controller\":" << JsonString(telemetry::StateName(s.controller_state)) << ",\"tec\":" << s.tec
+      << ",\"rec\":" << int{s.rec} << ",\"error_register\":" << JsonString(Hex(s.error_register, 2))
+      << ",\"heartbeat_ms\":" << s.heartbeat_producer_ms
+      << ",\"uptime_s\":" << Seconds(std::chrono::duration<double>(s.uptime).count())
+      << ",\"age_s\":" << Seconds(std::chrono::duration<double>(now - row.last_sample).count())
+      << ",\"alive\":" << (row.alive ? "true" : "false")
+      << ",\"stale\":" << (tools::IsStale(row, now) ? "true" : "false")
+      << ",\"faulted\":" << (tools::IsFaulted(row, now) ? "true" : "false") << ",\"rpdo\":" << s.rpdo_count
+      << ",\"tpdo\":" << s.tpdo_count << ",\"consumers\":[";
+  for (std::size_t i = 0; i < s.heartbeat_consumers.size(); ++i) {
+    const auto& c = s.heartbeat_consumers[i];
+    out << (i ? "," : "") << "{\"node\":" << int{c.node_id} << ",\"time_ms\":" << c.time_ms
+        << ",\"state\":" << JsonString(telemetry::ToString(c.state)) << '}';
+  }
+  out << "],\"last_emcy\":";
+  if (s.last_emcy)
+    out << "{\"code\":" << JsonString(Hex(s.last_emcy->code, 4))
+        << ",\"register\":" << JsonString(Hex(s.last_emcy->error_register, 2)) << '}';
+  else
+    out << "null";
+  out << ",\"emcy\":[";
+  for (std::size_t i = 0; i < row.emcy_history.size(); ++i) {
+    const auto& e = row.emcy_history[i];
+    std::string data;
+    for (const std::uint8_t b : e.sample.emcy.manufacturer)
+      data += (data.empty() ? "" : " ") + Hex(b, 2);
+    out << (i ? "," : "") << "{\"time\":" << Seconds(EpochSeconds(e.time))
+        << ",\"code\":" << JsonString(Hex(e.sample.emcy.code, 4))
+        << ",\"register\":" << JsonString(Hex(e.sample.emcy.error_register, 2))
+        << ",\"data\":" << JsonString(data) << '}';
+  }
+  out << "],\"inputs\":";
+  IoJson(out, row.io ? row.io->inputs : std::vector<telemetry::IoValueSample>{});
+  out << ",\"outputs\":";
+  IoJson(out, row.io ? row.io->outputs : std::vector<telemetry::IoValueSample>{});
+  out << '}';
+}
+
+void BusJson(std::ostringstream& out, const std::string& name, const tools::BusRow& row) {
+  out << "{\"name\":" << JsonString(name);
+  if (const auto& s = row.stats) {
+    out << ",\"bitrate\":" << s->bitrate << ",\"mode\":" << JsonString(s->mode)
+        << ",\"load\":" << Number(s->load_percent) << ",\"fps\":" << Number(s->frames_per_second)
+        << ",\"frames\":" << s->frames_total << ",\"error_frames\":" << s->error_frames
+        << ",\"nodes\":" << s->node_count << ",\"simulated_s\":" << Seconds(s->simulated_s)
+        << ",\"factor\":" << Number(s->speed_factor);
+  }
+  out << ",\"faults\":[";
+  bool first = true;
+  for (const auto& [id, f] : row.active_faults) {
+    out << (first ? "" : ",") << "{\"id\":" << id << ",\"kind\":" << JsonString(f.kind)
+        << ",\"node\":" << int{f.target_node} << ",\"parameters\":{";
+    for (std::size_t i = 0; i < f.parameters.size(); ++i)
+      out << (i ? "," : "") << JsonString(f.parameters[i].first) << ':' << JsonString(f.parameters[i].second);
+    out << "}}";
+    first = false;
+  }
+  out << "]}";
+}
+
+void ScenarioJson(std::ostringstream& out, const tools::ScenarioRow& row) {
+  const auto& s = row.status;
+  out << "{\"source\":" << JsonString(s.source) << ",\"scenario\":" << JsonString(s.scenario)
+      << ",\"time_mode\":" << JsonString(s.time_mode) << ",\"time_s\":" << Seconds(s.scenario_time_s)
+      << ",\"cycle\":" << s.cycle << ",\"running\":" << (s.running ? "true" : "false")
+      << ",\"alive\":" << (row.alive ? "true" : "false") << ",\"expectations\":" << s.expectations
+      << ",\"passed\":" << s.passed << ",\"failed\":" << s.failed << ",\"skipped\":" << s.skipped
+      << ",\"pending\":" << s.pending << ",\"step\":" << JsonString(s.step) << '}';
+}
+
+}  // namespace
+
+double EpochSeconds(tools::WallTime t) {
+  return std::chrono::duration<double>(t.time_since_epoch()).count();
+}
+
+WebState::WebState(tools::WallTime started, WebStateOptions options)
+    : options_(options), view_(started, 200) {}
+
+void WebState::Record(std::vector<tools::FleetEvent>& events) {
+  for (const auto& e : events)
+    events_.push_back({next_event_++, e.time, tools::FormatEventJson(e)});
+  while (events_.size() > options_.max_events)
+    events_.pop_front();
+  events.clear();
+}
+
+void WebState::AddPoint(tools::WallTime time, double simulated_s, std::string series, double value) {
+  points_.push_back({next_point_++, time, simulated_s, std::move(series), value});
+}
+
+void WebState::Apply(const telemetry::NodeStatusSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+}
+
+void WebState::Apply(const telemetry::EmcySample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+}
+
+void WebState::Apply(const telemetry::IoSnapshotSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+  if (!m.valid_data) return;
+  const std::string prefix = "io:" + s.bus + ":" + std::to_string(int{s.node_id}) + "/";
+  const auto sim = simulated_.find(s.bus);
+  const double simulated = sim == simulated_.end() ? -1 : sim->second;
+  for (const auto* values : {&s.inputs, &s.outputs})
+    for (const auto& v : *values)
+      AddPoint(m.source_time, simulated, prefix + v.name, v.value);
+}
+
+void WebState::Apply(const telemetry::BusStatsSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+  if (!m.valid_data) return;
+  const double simulated = s.mode == "virtual" ? s.simulated_s : -1;
+  if (simulated >= 0) simulated_[s.bus] = simulated;
+  const std::string prefix = "bus:" + s.bus + "/";
+  AddPoint(m.source_time, simulated, prefix + "load", s.load_percent);
+  AddPoint(m.source_time, simulated, prefix + "fps", s.frames_per_second);
+  AddPoint(m.source_time, simulated, prefix + "error_frames", static_cast<double>(s.error_frames));
+}
+
+void WebState::Apply(const telemetry::FaultEventSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+}
+
+void WebState::Apply(const telemetry::VerdictSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+}
+
+void WebState::Apply(const telemetry::ScenarioStatusSample& s, const telemetry::SampleMeta& m) {
+  std::lock_guard lock(mutex_);
+  view_.Apply(s, m, &scratch_);
+  Record(scratch_);
+}
+
+void WebState::Trim(tools::WallTime now) {
+  std::lock_guard lock(mutex_);
+  const auto oldest = now - options_.retention;
+  while (!points_.empty() && points_.front().time < oldest)
+    points_.pop_front();
+  while (!events_.empty() && events_.front().time < oldest)
+    events_.pop_front();
+}
+
+std::size_t WebState::EventCount() const {
+  std::lock_guard lock(mutex_);
+  return events_.size();
+}
+
+std::size_t WebState::PointCount() const {
+  std::lock_guard lock(mutex_);
+  return points_.size();
+}
+
+std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
+  std::lock_guard lock(mutex_);
+  std::ostringstream out;
+  out << "{\"type\":\"update\",\"now\":" << Seconds(EpochSeconds(now))
+      << ",\"retention_s\":" << options_.retention.count() << ",\"nodes\":[";
+  bool first = true;
+  for (const auto& [key, row] : view_.nodes()) {
+    if (!first) out << ',';
+    NodeJson(out, row, now);
+    first = false;
+  }
+  out << "],\"buses\":[";
+  first = true;
+  for (const auto& [name, row] : view_.buses()) {
+    if (!first) out << ',';
+    BusJson(out, name, row);
+    first = false;
+  }
+  out << "],\"scenarios\":[";
+  first = true;
+  for (const auto& [source, row] : view_.scenarios()) {
+    if (!first) out << ',';
+    ScenarioJson(out, row);
+    first = false;
+  }
+  out << "],\"events\":[";
+  first = true;
+  for (const auto& e : events_) {
+    if (e.seq <= cursor.event_seq) continue;
+    out << (first ? "" : ",") << e.json;
+    first = false;
+    cursor.event_seq = e.seq;
+  }
+  out << "],\"points\":[";
+  first = true;
+  for (const auto& p : points_) {
+    if (p.seq <= cursor.point_seq) continue;
+    out << (first ? "" : ",") << '[' << Seconds(EpochSeconds(p.time)) << ',' << JsonString(p.series) << ','
+        << Number(p.value) << ',' << Seconds(p.simulated_s) << ']';
+    first = false;
+    cursor.point_seq = p.seq;
+  }
+  out << "]}";
+  return out.str();
+}
+
+}  // namespace canfleet::web

@@ -1,0 +1,92 @@
+#pragma once
+/// @file What the browser view shows, built from the fleet's telemetry (the topics `canfleet top`
+/// reads, through the same FleetView): nodes, buses, scenarios, the fleet-wide timeline of events,
+/// and time series (bus statistics, simulated I/O signals) kept for a retention window. Serialised
+/// as JSON for the page: a full snapshot, then per client only what is new. No DDS and no clock of
+/// its own: tests feed it samples with their times.
+///
+/// Threading: one mutex; the telemetry thread applies samples, the server's thread reads.
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "tools/telemetry/fleet_view.hpp"
+
+namespace canfleet::web {
+
+struct WebStateOptions {
+  /// Time series and timeline older than this (source time) are dropped: it bounds memory.
+  std::chrono::seconds retention{600};
+  /// Timeline events kept at most (the oldest go first).
+  std::size_t max_events = 5000;
+};
+
+/// Where one client stands: what it has been sent already.
+struct Cursor {
+  std::uint64_t event_seq = 0;  ///< events up to this sequence number were sent
+  std::uint64_t point_seq = 0;  ///< series points up to this sequence number were sent
+};
+
+class WebState {
+ public:
+  explicit WebState(tools::WallTime started, WebStateOptions options = {});
+
+  void Apply(const telemetry::NodeStatusSample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::EmcySample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::IoSnapshotSample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::BusStatsSample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::FaultEventSample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::VerdictSample& s, const telemetry::SampleMeta& m);
+  void Apply(const telemetry::ScenarioStatusSample& s, const telemetry::SampleMeta& m);
+
+  /// One JSON message for a client at `cursor` (advanced to now): {"type":"update", "now", "nodes",
+  /// "buses", "scenarios", "events": [new], "points": [new]}. The first (a zero cursor) carries
+  /// every event and point still kept. Nodes, buses and scenarios are always whole: they are small
+  /// and a page that missed one update is right again with the next.
+  std::string UpdateJson(Cursor& cursor, tools::WallTime now) const;
+
+  /// Drops what is older than the retention window before `now`.
+  void Trim(tools::WallTime now);
+
+  std::size_t EventCount() const;
+  std::size_t PointCount() const;
+
+ private:
+  /// One value of a series at a time: bus statistics ("bus:can0/load"), a signal
+  /// ("io:can0:5/IN1.voltage_mV").
+  struct Point {
+    std::uint64_t seq = 0;
+    tools::WallTime time{};
+    double simulated_s = -1;  ///< the bus's simulated time, in virtual time; -1 otherwise
+    std::string series;
+    double value = 0;
+  };
+  struct Event {
+    std::uint64_t seq = 0;
+    tools::WallTime time{};
+    std::string json;  ///< tools::FormatEventJson
+  };
+  void Record(std::vector<tools::FleetEvent>& events);
+  void AddPoint(tools::WallTime time, double simulated_s, std::string series, double value);
+
+  mutable std::mutex mutex_;
+  WebStateOptions options_;
+  tools::FleetView view_;
+  std::deque<Event> events_;
+  std::deque<Point> points_;
+  std::uint64_t next_event_ = 1;
+  std::uint64_t next_point_ = 1;
+  std::vector<tools::FleetEvent> scratch_;
+  /// The latest simulated time each bus reported (virtual time), for the page's clock.
+  std::map<std::string, double> simulated_;
+};
+
+/// Seconds since the Unix epoch, as the page's time axis counts.
+double EpochSeconds(tools::WallTime t);
+
+}  // namespace canfleet::web
