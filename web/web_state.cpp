@@ -120,6 +120,33 @@ void ScenarioJson(std::ostringstream& out, const tools::ScenarioRow& row) {
 
 }  // namespace
 
+std::string ValidUtf8(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    std::size_t len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = len > 0 && i + len <= text.size();
+    for (std::size_t k = 1; ok && k < len; ++k)
+      ok = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+    if (ok && len > 1) {  // no overlong forms, surrogates or code points beyond U+10FFFF
+      const auto c1 = static_cast<unsigned char>(text[i + 1]);
+      ok = !(len == 2 && c < 0xC2) && !(len == 3 && c == 0xE0 && c1 < 0xA0) &&
+           !(len == 3 && c == 0xED && c1 >= 0xA0) && !(len == 4 && c == 0xF0 && c1 < 0x90) &&
+           !(len == 4 && (c > 0xF4 || (c == 0xF4 && c1 >= 0x90)));
+    }
+    if (ok) {
+      out.append(text.substr(i, len));
+      i += len;
+    } else {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    }
+  }
+  return out;
+}
+
 double EpochSeconds(tools::WallTime t) {
   return std::chrono::duration<double>(t.time_since_epoch()).count();
 }
@@ -257,7 +284,9 @@ std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
     cursor.point_seq = p.seq;
   }
   out << "]}";
-  return out.str();
+  // A WebSocket text message must be UTF-8 (RFC 6455 §5.6), else the browser drops the connection;
+  // a publisher's strings are whatever it sent.
+  return ValidUtf8(out.str());
 }
 
 }  // namespace canfleet::web

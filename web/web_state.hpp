@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tools/telemetry/fleet_view.hpp"
@@ -85,6 +86,9 @@ class WebState {
   /// The latest simulated time each bus reported (virtual time), for the page's clock.
   std::map<std::string, double> simulated_;
 };
+
+/// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD.
+std::string ValidUtf8(std::string_view text);
 
 /// Seconds since the Unix epoch, as the page's time axis counts.
 double EpochSeconds(tools::WallTime t);

@@ -118,5 +118,21 @@ TEST(WebState, NamesWithQuotesAndControlCharactersStayValidJson) {
             "a \"quoted\"\n\tname\\");
 }
 
+// A WebSocket text message must be UTF-8 (RFC 6455 §5.6): a publisher's bytes that are not become
+// U+FFFD, so one odd name cannot cut every page off.
+TEST(WebState, InvalidUtf8FromAPublisherBecomesReplacementCharacters) {
+  EXPECT_EQ(ValidUtf8("quad-5 \xC3\xA9"), "quad-5 \xC3\xA9") << "valid UTF-8 stays";
+  EXPECT_EQ(ValidUtf8("a\xFF" "b"), "a\xEF\xBF\xBD" "b");
+  EXPECT_EQ(ValidUtf8("\xC0\xAF"), "\xEF\xBF\xBD\xEF\xBF\xBD") << "overlong";
+  EXPECT_EQ(ValidUtf8("\xED\xA0\x80"), "\xEF\xBF\xBD\xEF\xBF\xBD\xEF\xBF\xBD") << "a surrogate";
+  EXPECT_EQ(ValidUtf8("\xE2\x82"), "\xEF\xBF\xBD\xEF\xBF\xBD") << "cut short";
+  WebState state(kStart);
+  state.Apply(Status(9, "bad \xFF name"), At(kStart + 1s));
+  Cursor cursor;
+  const auto msg = Parse(state.UpdateJson(cursor, kStart + 2s));
+  EXPECT_EQ(msg.fields().at("nodes").list_value().values(0).struct_value().fields().at("name").string_value(),
+            "bad \xEF\xBF\xBD name");
+}
+
 }  // namespace
 }  // namespace canfleet::web

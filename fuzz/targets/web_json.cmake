@@ -1,0 +1,1 @@
+canfleet_fuzz_target(web_json DEPS canfleet_web)
