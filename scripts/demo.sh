@@ -14,7 +14,8 @@
 # node's simulated I/O and EMCY history, Esc goes back. The demo topology's scenario moves inputs,
 # then injects and clears a heartbeat loss (40 s), an RPDO timeout (60 s) and a bus-off (80 s)
 # in turn, each followed by expectations of the EMCY, NMT and output reactions; it runs again 10 s
-# after it ended. `canfleet watch` in another terminal prints the events as lines.
+# after it ended. `canfleet watch` in another terminal prints the events as lines, and `canfleet
+# web` (started here, its URL printed) shows the fleet in a browser.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "${1:-}" = --docker ]; then
@@ -36,7 +37,12 @@ rm -f build/demo/ready
 # in when given none, so `canfleet top` and `canfleet watch` in another terminal see this fleet.
 "$bin/canfleet" up "$topology" --ready-file build/demo/ready >build/demo/orchestrator.log 2>&1 &
 up=$!
+web=""
 stop() {
+  if [ -n "$web" ]; then
+    kill "$web" 2>/dev/null || true
+    wait "$web" 2>/dev/null || true
+  fi
   "$bin/canfleet" down >/dev/null 2>&1 || kill "$up" 2>/dev/null || true
   wait "$up" 2>/dev/null || true
   echo "demo stopped; the orchestrator's log is build/demo/orchestrator.log"
@@ -52,6 +58,20 @@ for _ in $(seq 1 600); do
 done
 "$bin/canfleet" status
 echo
+# The same fleet in a browser (web/README.md): port 8080, or any free one when 8080 is taken.
+rm -f build/demo/web.ready
+for listen in 127.0.0.1:8080 127.0.0.1:0; do
+  "$bin/canfleet" web --listen "$listen" --ready-file build/demo/web.ready >build/demo/web.log 2>&1 &
+  web=$!
+  for _ in $(seq 1 50); do
+    [ -f build/demo/web.ready ] && break
+    kill -0 "$web" 2>/dev/null || break
+    sleep 0.1
+  done
+  [ -f build/demo/web.ready ] && break
+  web=""
+done
+[ -n "$web" ] && echo "in a browser: $(awk '/^url/{print $2}' build/demo/web.ready)  (canfleet web: overview, bus statistics, timeline, plots, fault controls)"
 echo "live view (canfleet top; up/down and Enter: a node's I/O and EMCYs); Ctrl-C stops the demo"
 echo "faults at 40 s, 60 s and 80 s after start; verdicts in top, canfleet watch --type verdict, or: grep expect build/demo/orchestrator.log"
 sleep 2

@@ -1,8 +1,11 @@
 // `canfleet up`: the broker's host (host::BrokerHost, as canfleet-broker has it) plus the fleet and
 // the control API, on one event loop.
 #include "orchestrator/fleet/run_fleet.hpp"
+#include "orchestrator/fleet/child_process.hpp"
 
 #include <spdlog/spdlog.h>
+
+#include <csignal>
 #include <unistd.h>
 
 #include <asio/io_context.hpp>
@@ -187,6 +190,28 @@ int RunFleet(const UpOptions& options) {
   });
   WriteStateFile(options.ready_file, control_endpoint, broker_endpoint, "starting");
 
+  // --web: `canfleet web` beside the fleet, as a child tied to this process (web/README.md).
+  pid_t web_pid = 0;
+  if (!options.web.empty()) {
+    const auto logs = std::filesystem::path(spec.orchestrator().state_root()) / "logs";
+    std::error_code ignored;
+    std::filesystem::create_directories(logs, ignored);
+    LaunchSpec web{.binary = std::filesystem::read_symlink("/proc/self/exe", ignored),
+                   .args = {"--control", control_endpoint, "web", "--listen", options.web, "--ready-file",
+                            (logs / "web.ready").string()},
+                   .log_file = logs / "web.log"};
+    for (auto& arg : telemetry::DdsArguments(options.dds))
+      web.args.push_back(std::move(arg));
+    try {
+      std::filesystem::remove(logs / "web.ready", ignored);
+      web_pid = SpawnChild(web);
+      spdlog::info("canfleet web on {} (pid {}; its URL: {}, log {})", options.web, web_pid,
+                   (logs / "web.ready").string(), web.log_file.string());
+    } catch (const std::exception& e) {
+      spdlog::error("canfleet web: {}", e.what());
+    }
+  }
+
   bool stopping = false;
   auto shutdown = [&](const char* why) {
     if (stopping) return;
@@ -194,6 +219,7 @@ int RunFleet(const UpOptions& options) {
     spdlog::info("{}: stopping the fleet", why);
     // Driven time runs on its own while the nodes stop: nobody steps it any more.
     if (auto* conductor = host.conductor(); conductor != nullptr && conductor->Driven()) conductor->Undrive();
+    if (web_pid > 0) kill(web_pid, SIGTERM);
     fleet->Stop([&] {
       spdlog::info("every node process has stopped");
       control_server->Close();

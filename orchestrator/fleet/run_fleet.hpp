@@ -25,6 +25,9 @@ struct UpOptions {
   /// Virtual time: from the moment the fleet is ready, time runs only inside a client's
   /// ClockAdvance (TimeConductor::Drive).
   bool driven = false;
+  /// --web [ADDR:]PORT: also serve the fleet in a browser (a `canfleet web` child process reading
+  /// the fleet's DDS domain, its actions going to this fleet's control API); empty: no.
+  std::string web;
   bool telemetry = true;  ///< BusStats and FaultEvents on DDS
   /// Where the orchestrator publishes (canfleet up's --dds-* options); also passed to its nodes.
   telemetry::DdsOptions dds;

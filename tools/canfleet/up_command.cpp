@@ -22,6 +22,7 @@ struct UpArgs {
   std::string log_level = "info";
   bool no_start = false;
   bool driven = false;
+  std::string web;
   bool telemetry = true;
   std::string time;       ///< "" = the topology's
   std::string speed;      ///< "" = the topology's
@@ -41,6 +42,7 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.log_level = args.log_level;
   options.no_start = args.no_start;
   options.driven = args.driven;
+  options.web = args.web;
   options.telemetry = args.telemetry;
   options.dds = args.dds;
   options.time.mode = args.time;
@@ -122,6 +124,9 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
                "Virtual time: once the fleet is ready (with --no-start: from time 0) its time runs only "
                "when a client advances it (the control API's ClockAdvance; python/canfleet's fleet.run, "
                "bus waits and expectations)");
+  up->add_option("--web", args->web,
+                 "Also serve the fleet in a browser on [ADDR:]PORT (canfleet web; its URL in "
+                 "<state_root>/logs/web.ready)");
   up->add_option("--state-dir", args->state_dir,
                  "Folder for the nodes' state and logs, instead of the topology's state_root (a private "
                  "fleet: tests, python/canfleet)");
