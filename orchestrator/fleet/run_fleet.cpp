@@ -5,8 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include <csignal>
 #include <unistd.h>
+#include <csignal>
 
 #include <asio/io_context.hpp>
 #include <fstream>
