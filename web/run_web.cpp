@@ -19,7 +19,6 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 std::atomic<telemetry::FleetReader*> g_reader{nullptr};
-std::atomic<WebServer*> g_server{nullptr};
 
 extern "C" void OnStopSignal(int) {
   g_stop = true;
