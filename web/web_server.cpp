@@ -1,5 +1,6 @@
 #include "web/web_server.hpp"
 
+#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 #include <spdlog/spdlog.h>
 
@@ -17,6 +18,7 @@
 #include <optional>
 #include <random>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "tools/telemetry/event_format.hpp"
@@ -143,7 +145,20 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   }
 
  private:
-  // The page sends nothing; reading notices a close, and a message over the limit ends the session.
+  // The page sends what it plots ({"plot": ["io:can0:5/IN1.voltage_mV", ...]}); reading also notices
+  // a close, and a message over the limit ends the session. Anything else is ignored.
+  void Subscribe(const std::string& text) {
+    google::protobuf::Struct message;
+    if (!google::protobuf::util::JsonStringToMessage(text, &message).ok()) return;
+    const auto it = message.fields().find("plot");
+    if (it == message.fields().end() || !it->second.has_list_value()) return;
+    std::set<std::string> plotted;
+    for (const auto& v : it->second.list_value().values())
+      if (v.has_string_value() && plotted.size() < 64) plotted.insert(v.string_value());
+    for (const auto& name : plotted)
+      if (!cursor_.plotted.contains(name)) cursor_.backfill.insert(name);
+    cursor_.plotted = std::move(plotted);
+  }
   void Read() {
     ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t n) {
       if (ec) {
@@ -151,6 +166,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
         self->timer_.cancel();
         return;
       }
+      self->Subscribe(beast::buffers_to_string(self->in_.data()));
       self->in_.consume(n);
       self->Read();
     });
@@ -329,6 +345,26 @@ Response WebServer::Impl::Answer(const Request& req, unsigned version, bool keep
     Cursor fresh;
     res.set(http::field::content_type, "application/json");
     res.body() = state.UpdateJson(fresh, std::chrono::system_clock::now());
+  } else if (target == "/api/node") {
+    // ?key=BUS:ID, as the page's node view asks for it.
+    std::string query(req.target().substr(std::min(req.target().size(), target.size() + 1)));
+    if (const auto encoded = query.find("%3A"); encoded != std::string::npos) query.replace(encoded, 3, ":");
+    const auto colon = query.rfind(':');
+    int id = -1;
+    if (query.starts_with("key=") && colon != std::string::npos) {
+      try {
+        id = std::stoi(query.substr(colon + 1));
+      } catch (const std::exception&) {
+      }
+    }
+    res.set(http::field::content_type, "application/json");
+    if (id < 0 || id > 127) {
+      res.result(http::status::bad_request);
+      res.body() = ErrorJson("/api/node?key=BUS:NODE-ID");
+    } else {
+      res.body() = state.NodeJson(query.substr(4, colon - 4), static_cast<std::uint8_t>(id),
+                                  std::chrono::system_clock::now());
+    }
   } else if (target == "/api/info") {
     res.set(http::field::content_type, "application/json");
     res.body() = Info();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <sstream>
 
 #include "tools/telemetry/event_format.hpp"
@@ -43,32 +44,38 @@ void IoJson(std::ostringstream& out, const std::vector<telemetry::IoValueSample>
   out << ']';
 }
 
-void NodeJson(std::ostringstream& out, const tools::NodeRow& row, tools::WallTime now) {
+void NodeSummaryJson(std::ostringstream& out, const tools::NodeRow& row, tools::WallTime now) {
   const auto& s = row.status;
-  out << "{\"bus\":" << JsonString(s.bus) << ",\"id\":" << int{s.node_id}
-      << ",\"name\":" << JsonString(s.name) << ",\"device\":" << JsonString(s.device)
+  out << "{\"key\":" << JsonString(s.bus + ":" + std::to_string(int{s.node_id})) << ",\"bus\":" << JsonString(s.bus)
+      << ",\"id\":" << int{s.node_id} << ",\"name\":" << JsonString(s.name) << ",\"device\":" << JsonString(s.device)
       << ",\"nmt\":" << JsonString(telemetry::StateName(s.nmt_state))
       << ",\"controller\":" << JsonString(telemetry::StateName(s.controller_state)) << ",\"tec\":" << s.tec
       << ",\"rec\":" << int{s.rec} << ",\"error_register\":" << JsonString(Hex(s.error_register, 2))
       << ",\"heartbeat_ms\":" << s.heartbeat_producer_ms
-      << ",\"uptime_s\":" << Seconds(std::chrono::duration<double>(s.uptime).count())
-      << ",\"age_s\":" << Seconds(std::chrono::duration<double>(now - row.last_sample).count())
+      << ",\"last_sample\":" << Seconds(EpochSeconds(row.last_sample))
       << ",\"alive\":" << (row.alive ? "true" : "false")
       << ",\"stale\":" << (tools::IsStale(row, now) ? "true" : "false")
-      << ",\"faulted\":" << (tools::IsFaulted(row, now) ? "true" : "false") << ",\"rpdo\":" << s.rpdo_count
+      << ",\"faulted\":" << (tools::IsFaulted(row, now) ? "true" : "false") << ",\"last_emcy\":";
+  if (s.last_emcy)
+    out << "{\"code\":" << JsonString(Hex(s.last_emcy->code, 4)) << ",\"register\":"
+        << JsonString(Hex(s.last_emcy->error_register, 2)) << '}';
+  else
+    out << "null";
+  out << '}';
+}
+
+void NodeDetailJson(std::ostringstream& out, const tools::NodeRow& row, tools::WallTime now) {
+  const auto& s = row.status;
+  out << "{\"summary\":";
+  NodeSummaryJson(out, row, now);
+  out << ",\"uptime_s\":" << Seconds(std::chrono::duration<double>(s.uptime).count()) << ",\"rpdo\":" << s.rpdo_count
       << ",\"tpdo\":" << s.tpdo_count << ",\"consumers\":[";
   for (std::size_t i = 0; i < s.heartbeat_consumers.size(); ++i) {
     const auto& c = s.heartbeat_consumers[i];
     out << (i ? "," : "") << "{\"node\":" << int{c.node_id} << ",\"time_ms\":" << c.time_ms
         << ",\"state\":" << JsonString(telemetry::ToString(c.state)) << '}';
   }
-  out << "],\"last_emcy\":";
-  if (s.last_emcy)
-    out << "{\"code\":" << JsonString(Hex(s.last_emcy->code, 4))
-        << ",\"register\":" << JsonString(Hex(s.last_emcy->error_register, 2)) << '}';
-  else
-    out << "null";
-  out << ",\"emcy\":[";
+  out << "],\"emcy\":[";
   for (std::size_t i = 0; i < row.emcy_history.size(); ++i) {
     const auto& e = row.emcy_history[i];
     std::string data;
@@ -163,6 +170,7 @@ void WebState::Record(std::vector<tools::FleetEvent>& events) {
 }
 
 void WebState::AddPoint(tools::WallTime time, double simulated_s, std::string series, double value) {
+  if (!series_names_.contains(series)) series_names_.insert(series);
   points_.push_back({next_point_++, time, simulated_s, std::move(series), value});
 }
 
@@ -241,15 +249,30 @@ std::size_t WebState::PointCount() const {
   return points_.size();
 }
 
+std::string WebState::NodeJson(const std::string& bus, std::uint8_t node_id, tools::WallTime now) const {
+  std::lock_guard lock(mutex_);
+  const auto it = view_.nodes().find({bus, node_id});
+  if (it == view_.nodes().end()) return "null";
+  std::ostringstream out;
+  NodeDetailJson(out, it->second, now);
+  return ValidUtf8(out.str());
+}
+
 std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
   std::lock_guard lock(mutex_);
   std::ostringstream out;
-  out << "{\"type\":\"update\",\"now\":" << Seconds(EpochSeconds(now))
-      << ",\"retention_s\":" << options_.retention.count() << ",\"nodes\":[";
+  out << "{\"type\":\"update\",\"now\":" << Seconds(EpochSeconds(now)) << ",\"retention_s\":"
+      << options_.retention.count() << ",\"nodes\":[";
   bool first = true;
   for (const auto& [key, row] : view_.nodes()) {
-    if (!first) out << ',';
-    NodeJson(out, row, now);
+    std::ostringstream node;
+    NodeSummaryJson(node, row, now);
+    const std::string json = node.str();
+    const std::size_t hash = std::hash<std::string>{}(json);
+    auto& sent = cursor.node_hashes[key.bus + ":" + std::to_string(int{key.node_id})];
+    if (sent == hash) continue;
+    sent = hash;
+    out << (first ? "" : ",") << json;
     first = false;
   }
   out << "],\"buses\":[";
@@ -277,13 +300,27 @@ std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
   out << "],\"points\":[";
   first = true;
   for (const auto& p : points_) {
-    if (p.seq <= cursor.point_seq) continue;
+    const bool fresh = p.seq > cursor.point_seq;
+    const bool wanted = p.series.starts_with("bus:") || cursor.plotted.contains(p.series);
+    if (!wanted || !(fresh || cursor.backfill.contains(p.series))) continue;
     out << (first ? "" : ",") << '[' << Seconds(EpochSeconds(p.time)) << ',' << JsonString(p.series) << ','
         << Number(p.value) << ',' << Seconds(p.simulated_s) << ']';
     first = false;
-    cursor.point_seq = p.seq;
   }
-  out << "]}";
+  if (!points_.empty()) cursor.point_seq = points_.back().seq;
+  cursor.backfill.clear();
+  out << ']';
+  if (series_names_.size() != cursor.series_sent) {
+    cursor.series_sent = series_names_.size();
+    out << ",\"series\":[";
+    first = true;
+    for (const auto& name : series_names_) {
+      out << (first ? "" : ",") << JsonString(name);
+      first = false;
+    }
+    out << ']';
+  }
+  out << '}';
   // A WebSocket text message must be UTF-8 (RFC 6455 §5.6), else the browser drops the connection;
   // a publisher's strings are whatever it sent.
   return ValidUtf8(out.str());

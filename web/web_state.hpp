@@ -12,6 +12,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,10 +28,17 @@ struct WebStateOptions {
   std::size_t max_events = 5000;
 };
 
-/// Where one client stands: what it has been sent already.
+/// Where one client stands: what it has been sent already, and which series it plots.
 struct Cursor {
   std::uint64_t event_seq = 0;  ///< events up to this sequence number were sent
   std::uint64_t point_seq = 0;  ///< series points up to this sequence number were sent
+  /// Each node's summary as last sent (by "bus:id"): a node is sent again only when it changed.
+  std::map<std::string, std::size_t> node_hashes;
+  std::size_t series_sent = 0;  ///< how many series names were known when the list was last sent
+  /// Signal series the client plots ("io:can0:5/IN1.voltage_mV"): only their points are sent (bus
+  /// statistics always). Names added since the last update get every point still kept.
+  std::set<std::string> plotted;
+  std::set<std::string> backfill;
 };
 
 class WebState {
@@ -45,11 +53,14 @@ class WebState {
   void Apply(const telemetry::VerdictSample& s, const telemetry::SampleMeta& m);
   void Apply(const telemetry::ScenarioStatusSample& s, const telemetry::SampleMeta& m);
 
-  /// One JSON message for a client at `cursor` (advanced to now): {"type":"update", "now", "nodes",
-  /// "buses", "scenarios", "events": [new], "points": [new]}. The first (a zero cursor) carries
-  /// every event and point still kept. Nodes, buses and scenarios are always whole: they are small
-  /// and a page that missed one update is right again with the next.
+  /// One JSON message for a client at `cursor` (advanced to now): {"type":"update", "now",
+  /// "nodes": [the summaries that changed], "buses", "scenarios" (whole: they are few), "events":
+  /// [new], "points": [new, of bus statistics and the plotted series], "series": [every series
+  /// name, when there are new ones]}. The first (a zero cursor) carries everything still kept.
   std::string UpdateJson(Cursor& cursor, tools::WallTime now) const;
+  /// One node in full (the page's node view): its summary, simulated I/O with units, EMCY history,
+  /// heartbeat consumers. "null" for a node nobody published.
+  std::string NodeJson(const std::string& bus, std::uint8_t node_id, tools::WallTime now) const;
 
   /// Drops what is older than the retention window before `now`.
   void Trim(tools::WallTime now);
@@ -85,6 +96,7 @@ class WebState {
   std::vector<tools::FleetEvent> scratch_;
   /// The latest simulated time each bus reported (virtual time), for the page's clock.
   std::map<std::string, double> simulated_;
+  std::set<std::string> series_names_;  ///< every series seen (the page's picker)
 };
 
 /// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD.

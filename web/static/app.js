@@ -9,8 +9,9 @@ const FAULT_KINDS = ["HEARTBEAT_LOSS", "BUS_OFF", "ERROR_PASSIVE", "RPDO_TIMEOUT
 
 // Everything the page knows; tests read it (window.canfleet).
 const fleet = {
-  nodes: [], buses: [], scenarios: [], events: [], series: {}, retention: 600, now: 0,
-  selected: null, plotted: [], span: 60, messages: 0, connected: false,
+  nodes: [], byKey: {}, buses: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
+  retention: 600, now: 0,
+  selected: null, plotted: [], span: 60, messages: 0, bytes: 0, connected: false,
 };
 window.canfleet = fleet;
 
@@ -21,7 +22,10 @@ function apply(msg) {
   fleet.messages += 1;
   fleet.now = msg.now;
   fleet.retention = msg.retention_s;
-  fleet.nodes = msg.nodes;
+  // Nodes come when they changed: keep them by key, list them by bus and node-ID.
+  for (const n of msg.nodes) fleet.byKey[n.key] = n;
+  fleet.nodes = Object.values(fleet.byKey).sort((a, b) => a.bus.localeCompare(b.bus) || a.id - b.id);
+  if (msg.series) fleet.seriesNames = msg.series;
   fleet.buses = msg.buses;
   fleet.scenarios = msg.scenarios;
   for (const e of msg.events) {
@@ -43,9 +47,26 @@ function apply(msg) {
 
 function connect() {
   const ws = new WebSocket(`${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws`);
-  ws.onopen = () => { fleet.connected = true; setLink(); };
-  ws.onmessage = (ev) => apply(JSON.parse(ev.data));
+  ws.onopen = () => { fleet.connected = true; fleet.ws = ws; setLink(); subscribe(); };
+  ws.onmessage = (ev) => { fleet.bytes += ev.data.length; apply(JSON.parse(ev.data)); };
   ws.onclose = () => { fleet.connected = false; setLink(); setTimeout(connect, 1000); };
+}
+
+// The server sends the points of the plotted series only (bus statistics always).
+function subscribe() {
+  if (fleet.ws && fleet.ws.readyState === WebSocket.OPEN) fleet.ws.send(JSON.stringify({ plot: fleet.plotted }));
+}
+
+// The selected node in full (its I/O, EMCY history), asked for once a second while it is shown.
+async function refreshDetail() {
+  if (fleet.selected) {
+    try {
+      const res = await fetch("/api/node?key=" + fleet.selected);
+      fleet.detail = await res.json();
+      scheduleRender();
+    } catch (e) { /* the next try */ }
+  }
+  setTimeout(refreshDetail, 1000);
 }
 
 function setLink() {
@@ -108,27 +129,40 @@ function renderHeader() {
     : new Date(fleet.now * 1000).toLocaleTimeString();
 }
 
+// Rows are kept by node: a node's cells are rebuilt only when its summary changed (the server sends
+// it only then), the age of its last status every frame; 500 nodes stay cheap to show.
+const rows = new Map();
 function renderOverview() {
   const body = document.querySelector("#overview tbody");
-  body.replaceChildren();
+  let added = false;
   for (const n of fleet.nodes) {
-    const tr = el("tr", { "data-node": nodeKey(n), "data-name": n.name });
-    if (n.faulted) tr.classList.add("faulted");
-    if (n.stale || !n.alive) tr.classList.add("stale");
-    if (fleet.selected === nodeKey(n)) tr.classList.add("selected");
-    const cells = [n.bus, n.id, n.name, n.device, n.nmt, n.controller, n.tec, n.rec, n.error_register + "h",
-      n.heartbeat_ms ? n.heartbeat_ms + " ms" : "off", n.alive ? n.age_s.toFixed(1) + " s ago" : "gone",
-      n.last_emcy ? `${n.last_emcy.code}h (${n.last_emcy.register}h)` : ""];
-    cells.forEach((c, i) => {
-      const td = el("td", {}, String(c));
-      if (i === 4) td.className = "state-" + n.nmt;
-      if (i === 4) td.setAttribute("data-field", "nmt");
-      if (i === 8) td.setAttribute("data-field", "error-register");
-      tr.appendChild(td);
-    });
-    tr.onclick = () => { fleet.selected = nodeKey(n); scheduleRender(); };
-    body.appendChild(tr);
+    let row = rows.get(n.key);
+    if (!row) {
+      row = { tr: el("tr", { "data-node": n.key, "data-name": n.name }), node: null, age: null, selected: null };
+      row.tr.onclick = () => { fleet.selected = n.key; fleet.detail = null; refreshNow(); scheduleRender(); };
+      rows.set(n.key, row);
+      added = true;
+    }
+    if (row.node !== n) {
+      row.node = n;
+      row.tr.classList.toggle("faulted", n.faulted);
+      row.tr.classList.toggle("stale", n.stale || !n.alive);
+      const cells = [n.bus, n.id, n.name, n.device, n.nmt, n.controller, n.tec, n.rec, n.error_register + "h",
+        n.heartbeat_ms ? n.heartbeat_ms + " ms" : "off", "",
+        n.last_emcy ? `${n.last_emcy.code}h (${n.last_emcy.register}h)` : ""];
+      row.tr.replaceChildren(...cells.map((c, i) => {
+        const td = el("td", {}, String(c));
+        if (i === 4) { td.className = "state-" + n.nmt; td.setAttribute("data-field", "nmt"); }
+        if (i === 8) td.setAttribute("data-field", "error-register");
+        return td;
+      }));
+      row.age = row.tr.children[10];
+    }
+    row.age.textContent = n.alive ? Math.max(0, fleet.now - n.last_sample).toFixed(1) + " s ago" : "gone";
+    const selected = fleet.selected === n.key;
+    if (row.selected !== selected) { row.tr.classList.toggle("selected", selected); row.selected = selected; }
   }
+  if (added) body.replaceChildren(...fleet.nodes.map((n) => rows.get(n.key).tr));
 }
 
 function lineChart(svg, series, opts) {
@@ -176,9 +210,11 @@ function renderBuses() {
   }
 }
 
+let refreshNow = () => {};
 function renderDetail() {
   const box = document.getElementById("detail");
-  const n = fleet.nodes.find((x) => nodeKey(x) === fleet.selected);
+  const d = fleet.detail && fleet.detail.summary && nodeKey(fleet.detail.summary) === fleet.selected ? fleet.detail : null;
+  const n = d ? { ...d, ...d.summary } : null;
   document.getElementById("detail-title").textContent = n ? `${n.name || n.bus + " #" + n.id} (${n.device})` : "(click a row)";
   box.replaceChildren();
   if (!n) return;
@@ -244,7 +280,7 @@ function renderTimeline() {
 
 function renderPlotPicker() {
   const pick = document.getElementById("series-pick");
-  const names = Object.keys(fleet.series).sort();
+  const names = fleet.seriesNames;
   if (pick.options.length === names.length) return;
   const chosen = pick.value;
   pick.replaceChildren(...names.map((n) => el("option", { value: n }, n)));
@@ -253,6 +289,7 @@ function renderPlotPicker() {
 
 function addPlot(name) {
   if (name && !fleet.plotted.includes(name)) fleet.plotted.push(name);
+  subscribe();
   scheduleRender();
 }
 
@@ -318,7 +355,7 @@ function setup() {
     showResult(await action({ fault_inject: spec }));
   };
   document.getElementById("plot-add").onclick = () => addPlot(document.getElementById("series-pick").value);
-  document.getElementById("plot-clear").onclick = () => { fleet.plotted = []; scheduleRender(); };
+  document.getElementById("plot-clear").onclick = () => { fleet.plotted = []; subscribe(); scheduleRender(); };
   document.getElementById("plot-csv").onclick = plotCsv;
   for (const b of document.querySelectorAll(".zoom button")) b.onclick = () => { fleet.span = Number(b.dataset.span); scheduleRender(); };
   document.getElementById("timeline").addEventListener("wheel", (ev) => {
@@ -327,6 +364,8 @@ function setup() {
     scheduleRender();
   });
   window.canfleetActions = { action, addPlot, plotCsv };
+  refreshNow = () => { fetch("/api/node?key=" + fleet.selected).then((r) => r.json()).then((d) => { fleet.detail = d; scheduleRender(); }); };
   connect();
+  refreshDetail();
 }
 setup();

@@ -56,14 +56,28 @@ TEST(WebState, TheFirstUpdateCarriesEverythingAndTheNextOnlyWhatIsNew) {
   EXPECT_EQ(Count(first, "nodes"), 1u);
   EXPECT_EQ(Count(first, "events"), 2u) << "node seen, EMCY";
   const auto& node = first.fields().at("nodes").list_value().values(0).struct_value().fields();
+  EXPECT_EQ(node.at("key").string_value(), "can0:5");
   EXPECT_EQ(node.at("name").string_value(), "quad-5");
   EXPECT_EQ(node.at("nmt").string_value(), "operational");
-  EXPECT_EQ(node.at("emcy").list_value().values(0).struct_value().fields().at("code").string_value(), "8130");
-  EXPECT_DOUBLE_EQ(node.at("age_s").number_value(), 2.0);
+  EXPECT_FALSE(node.at("faulted").bool_value());
+  EXPECT_DOUBLE_EQ(node.at("last_sample").number_value(), EpochSeconds(kStart + 1s));
 
   const auto second = Parse(state.UpdateJson(cursor, kStart + 4s));
   EXPECT_EQ(Count(second, "events"), 0u);
-  EXPECT_EQ(Count(second, "nodes"), 1u) << "the state is whole in every update";
+  EXPECT_EQ(Count(second, "nodes"), 0u) << "a node is sent again only when it changed";
+  telemetry::NodeStatusSample changed = Status(5, "quad-5");
+  changed.nmt_state = telemetry::NmtState::kPreOperational;
+  state.Apply(changed, At(kStart + 5s));
+  const auto third = Parse(state.UpdateJson(cursor, kStart + 6s));
+  ASSERT_EQ(Count(third, "nodes"), 1u);
+  EXPECT_EQ(third.fields().at("nodes").list_value().values(0).struct_value().fields().at("nmt").string_value(),
+            "pre-operational");
+
+  // The node view asks for one node in full: its EMCY history among the rest.
+  const auto detail = Parse(state.NodeJson("can0", 5, kStart + 6s));
+  EXPECT_EQ(detail.fields().at("emcy").list_value().values(0).struct_value().fields().at("code").string_value(),
+            "8130");
+  EXPECT_EQ(state.NodeJson("can0", 99, kStart + 6s), "null");
 }
 
 TEST(WebState, BusStatisticsAndSignalsBecomeSeriesWithSimulatedTimeInVirtualTime) {
@@ -82,17 +96,23 @@ TEST(WebState, BusStatisticsAndSignalsBecomeSeriesWithSimulatedTimeInVirtualTime
   state.Apply(io, At(kStart + 2s));
 
   Cursor cursor;
+  const auto unplotted = Parse(state.UpdateJson(cursor, kStart + 3s));
+  EXPECT_EQ(Count(unplotted, "points"), 3u) << "bus statistics always, a signal only when plotted";
+  EXPECT_EQ(Count(unplotted, "series"), 4u) << "every series name, for the picker";
+  cursor.plotted = {"io:can0:5/IN1.voltage_mV"};
+  cursor.backfill = cursor.plotted;
   const auto msg = Parse(state.UpdateJson(cursor, kStart + 3s));
-  ASSERT_EQ(Count(msg, "points"), 4u) << "load, frames/s, error frames, IN1";
-  const auto& points = msg.fields().at("points").list_value();
+  ASSERT_EQ(Count(msg, "points"), 1u) << "the newly plotted series, with the points still kept";
+  EXPECT_FALSE(msg.fields().contains("series")) << "no new series";
+  const auto& in1 = msg.fields().at("points").list_value().values(0).list_value();
+  EXPECT_EQ(in1.values(1).string_value(), "io:can0:5/IN1.voltage_mV");
+  EXPECT_DOUBLE_EQ(in1.values(2).number_value(), 1800);
+  EXPECT_DOUBLE_EQ(in1.values(3).number_value(), 42.5) << "the bus's latest simulated time";
+  const auto& points = unplotted.fields().at("points").list_value();
   const auto& load = points.values(0).list_value();
   EXPECT_EQ(load.values(1).string_value(), "bus:can0/load");
   EXPECT_DOUBLE_EQ(load.values(2).number_value(), 12.5);
   EXPECT_DOUBLE_EQ(load.values(3).number_value(), 42.5);
-  const auto& in1 = points.values(3).list_value();
-  EXPECT_EQ(in1.values(1).string_value(), "io:can0:5/IN1.voltage_mV");
-  EXPECT_DOUBLE_EQ(in1.values(2).number_value(), 1800);
-  EXPECT_DOUBLE_EQ(in1.values(3).number_value(), 42.5) << "the bus's latest simulated time";
 }
 
 TEST(WebState, TheRetentionWindowBoundsWhatIsKept) {
