@@ -10,6 +10,7 @@
 
 #include "telemetry/cli_options.hpp"
 #include "telemetry/fleet_reader.hpp"
+#include "web/bus_monitor.hpp"
 #include "web/web_server.hpp"
 #include "web/web_state.hpp"
 
@@ -63,6 +64,9 @@ void AddWebOptions(CLI::App& app, WebOptions& options) {
       ->check(CLI::Range(10, 86400));
   app.add_option("--update-ms", options.update_ms, "Milliseconds between updates to the page (default 200)")
       ->check(CLI::Range(50, 10000));
+  app.add_option("--broker", options.broker,
+                 "Broker endpoint (tcp://HOST:PORT, unix:///path) to watch the buses as a monitor: heartbeat "
+                 "period min/max/jitter, SDO response times, boot-ups per node");
   app.add_option("--ready-file", options.ready_file,
                  "Written once serving: \"url <url>\" (and \"token <token>\")");
   telemetry::AddDdsOptions(app, options.dds);  // a reader: it must discover the writers
@@ -123,6 +127,12 @@ int RunWeb(const WebOptions& options) {
     }
     std::filesystem::rename(tmp, options.ready_file);
   }
+  std::unique_ptr<BusMonitor> monitor;
+  if (!options.broker.empty())
+    monitor = std::make_unique<BusMonitor>(
+        options.broker, [&state](const std::string& bus, const CanFrame& frame, std::int64_t time_ns) {
+          state.Frame(bus, frame, time_ns);
+        });
   std::thread serving([&] { server->Run(); });
   auto last_trim = std::chrono::steady_clock::now();
   while (!g_stop) {
@@ -131,6 +141,9 @@ int RunWeb(const WebOptions& options) {
     if (std::chrono::steady_clock::now() - last_trim > std::chrono::seconds(1)) {
       state.Trim(std::chrono::system_clock::now());
       last_trim = std::chrono::steady_clock::now();
+      if (monitor)
+        for (const auto& bus : state.BusNames())
+          monitor->Watch(bus);
     }
   }
   g_reader = nullptr;

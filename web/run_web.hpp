@@ -17,6 +17,7 @@ struct WebOptions {
   std::string listen = "127.0.0.1:8080";  ///< [ADDR:]PORT
   std::filesystem::path static_dir;       ///< empty: the repository's web/static
   std::string control;                    ///< control endpoint for actions; empty: read-only
+  std::string broker;                     ///< broker endpoint for CANopen-Diag statistics; empty: none
   bool read_only = false;
   std::string token;
   int retention_s = 600;

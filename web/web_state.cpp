@@ -46,8 +46,9 @@ void IoJson(std::ostringstream& out, const std::vector<telemetry::IoValueSample>
 
 void NodeSummaryJson(std::ostringstream& out, const tools::NodeRow& row, tools::WallTime now) {
   const auto& s = row.status;
-  out << "{\"key\":" << JsonString(s.bus + ":" + std::to_string(int{s.node_id})) << ",\"bus\":" << JsonString(s.bus)
-      << ",\"id\":" << int{s.node_id} << ",\"name\":" << JsonString(s.name) << ",\"device\":" << JsonString(s.device)
+  out << "{\"key\":" << JsonString(s.bus + ":" + std::to_string(int{s.node_id}))
+      << ",\"bus\":" << JsonString(s.bus) << ",\"id\":" << int{s.node_id}
+      << ",\"name\":" << JsonString(s.name) << ",\"device\":" << JsonString(s.device)
       << ",\"nmt\":" << JsonString(telemetry::StateName(s.nmt_state))
       << ",\"controller\":" << JsonString(telemetry::StateName(s.controller_state)) << ",\"tec\":" << s.tec
       << ",\"rec\":" << int{s.rec} << ",\"error_register\":" << JsonString(Hex(s.error_register, 2))
@@ -57,8 +58,8 @@ void NodeSummaryJson(std::ostringstream& out, const tools::NodeRow& row, tools::
       << ",\"stale\":" << (tools::IsStale(row, now) ? "true" : "false")
       << ",\"faulted\":" << (tools::IsFaulted(row, now) ? "true" : "false") << ",\"last_emcy\":";
   if (s.last_emcy)
-    out << "{\"code\":" << JsonString(Hex(s.last_emcy->code, 4)) << ",\"register\":"
-        << JsonString(Hex(s.last_emcy->error_register, 2)) << '}';
+    out << "{\"code\":" << JsonString(Hex(s.last_emcy->code, 4))
+        << ",\"register\":" << JsonString(Hex(s.last_emcy->error_register, 2)) << '}';
   else
     out << "null";
   out << '}';
@@ -68,8 +69,8 @@ void NodeDetailJson(std::ostringstream& out, const tools::NodeRow& row, tools::W
   const auto& s = row.status;
   out << "{\"summary\":";
   NodeSummaryJson(out, row, now);
-  out << ",\"uptime_s\":" << Seconds(std::chrono::duration<double>(s.uptime).count()) << ",\"rpdo\":" << s.rpdo_count
-      << ",\"tpdo\":" << s.tpdo_count << ",\"consumers\":[";
+  out << ",\"uptime_s\":" << Seconds(std::chrono::duration<double>(s.uptime).count())
+      << ",\"rpdo\":" << s.rpdo_count << ",\"tpdo\":" << s.tpdo_count << ",\"consumers\":[";
   for (std::size_t i = 0; i < s.heartbeat_consumers.size(); ++i) {
     const auto& c = s.heartbeat_consumers[i];
     out << (i ? "," : "") << "{\"node\":" << int{c.node_id} << ",\"time_ms\":" << c.time_ms
@@ -230,6 +231,11 @@ void WebState::Apply(const telemetry::ScenarioStatusSample& s, const telemetry::
   Record(scratch_);
 }
 
+void WebState::Frame(const std::string& bus, const CanFrame& frame, std::int64_t time_ns) {
+  std::lock_guard lock(mutex_);
+  diag_.Frame(bus, frame, time_ns);
+}
+
 void WebState::Trim(tools::WallTime now) {
   std::lock_guard lock(mutex_);
   const auto oldest = now - options_.retention;
@@ -237,6 +243,16 @@ void WebState::Trim(tools::WallTime now) {
     points_.pop_front();
   while (!events_.empty() && events_.front().time < oldest)
     events_.pop_front();
+}
+
+std::vector<std::string> WebState::BusNames() const {
+  std::lock_guard lock(mutex_);
+  std::set<std::string> names;
+  for (const auto& [name, row] : view_.buses())
+    names.insert(name);
+  for (const auto& [key, row] : view_.nodes())
+    names.insert(key.bus);
+  return {names.begin(), names.end()};
 }
 
 std::size_t WebState::EventCount() const {
@@ -255,14 +271,17 @@ std::string WebState::NodeJson(const std::string& bus, std::uint8_t node_id, too
   if (it == view_.nodes().end()) return "null";
   std::ostringstream out;
   NodeDetailJson(out, it->second, now);
-  return ValidUtf8(out.str());
+  std::string json = out.str();
+  const NodeDiag* diag = diag_.Find(bus, node_id);
+  json.insert(json.size() - 1, ",\"diag\":" + (diag ? DiagStats::Json(*diag) : std::string("null")));
+  return ValidUtf8(json);
 }
 
 std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
   std::lock_guard lock(mutex_);
   std::ostringstream out;
-  out << "{\"type\":\"update\",\"now\":" << Seconds(EpochSeconds(now)) << ",\"retention_s\":"
-      << options_.retention.count() << ",\"nodes\":[";
+  out << "{\"type\":\"update\",\"now\":" << Seconds(EpochSeconds(now))
+      << ",\"retention_s\":" << options_.retention.count() << ",\"nodes\":[";
   bool first = true;
   for (const auto& [key, row] : view_.nodes()) {
     std::ostringstream node;
@@ -310,6 +329,24 @@ std::string WebState::UpdateJson(Cursor& cursor, tools::WallTime now) const {
   if (!points_.empty()) cursor.point_seq = points_.back().seq;
   cursor.backfill.clear();
   out << ']';
+  if (now - cursor.diag_sent >= std::chrono::seconds(1)) {
+    cursor.diag_sent = now;
+    out << ",\"diag\":{";
+    first = true;
+    for (const auto& [key, row] : view_.nodes()) {
+      const NodeDiag* diag = diag_.Find(key.bus, key.node_id);
+      if (diag == nullptr) continue;
+      const std::string json = DiagStats::Json(*diag);
+      const std::string name = key.bus + ":" + std::to_string(int{key.node_id});
+      auto& sent = cursor.diag_hashes[name];
+      const std::size_t hash = std::hash<std::string>{}(json);
+      if (sent == hash) continue;
+      sent = hash;
+      out << (first ? "" : ",") << JsonString(name) << ':' << json;
+      first = false;
+    }
+    out << '}';
+  }
   if (series_names_.size() != cursor.series_sent) {
     cursor.series_sent = series_names_.size();
     out << ",\"series\":[";

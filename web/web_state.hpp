@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tools/telemetry/fleet_view.hpp"
+#include "web/diag_stats.hpp"
 
 namespace canfleet::web {
 
@@ -39,6 +40,9 @@ struct Cursor {
   /// statistics always). Names added since the last update get every point still kept.
   std::set<std::string> plotted;
   std::set<std::string> backfill;
+  /// Each node's statistics as last sent; they go at most once a second, and only what changed.
+  std::map<std::string, std::size_t> diag_hashes;
+  tools::WallTime diag_sent{};
 };
 
 class WebState {
@@ -52,6 +56,8 @@ class WebState {
   void Apply(const telemetry::FaultEventSample& s, const telemetry::SampleMeta& m);
   void Apply(const telemetry::VerdictSample& s, const telemetry::SampleMeta& m);
   void Apply(const telemetry::ScenarioStatusSample& s, const telemetry::SampleMeta& m);
+  /// A frame a bus monitor saw (`canfleet web --broker`): CANopen-Diag statistics (diag_stats.hpp).
+  void Frame(const std::string& bus, const CanFrame& frame, std::int64_t time_ns);
 
   /// One JSON message for a client at `cursor` (advanced to now): {"type":"update", "now",
   /// "nodes": [the summaries that changed], "buses", "scenarios" (whole: they are few), "events":
@@ -65,6 +71,8 @@ class WebState {
   /// Drops what is older than the retention window before `now`.
   void Trim(tools::WallTime now);
 
+  /// Every bus the telemetry named (statistics or a node on it).
+  std::vector<std::string> BusNames() const;
   std::size_t EventCount() const;
   std::size_t PointCount() const;
 
@@ -97,6 +105,7 @@ class WebState {
   /// The latest simulated time each bus reported (virtual time), for the page's clock.
   std::map<std::string, double> simulated_;
   std::set<std::string> series_names_;  ///< every series seen (the page's picker)
+  DiagStats diag_;
 };
 
 /// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD.

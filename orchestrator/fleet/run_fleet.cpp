@@ -197,8 +197,8 @@ int RunFleet(const UpOptions& options) {
     std::error_code ignored;
     std::filesystem::create_directories(logs, ignored);
     LaunchSpec web{.binary = std::filesystem::read_symlink("/proc/self/exe", ignored),
-                   .args = {"--control", control_endpoint, "web", "--listen", options.web, "--ready-file",
-                            (logs / "web.ready").string()},
+                   .args = {"--control", control_endpoint, "web", "--listen", options.web, "--broker",
+                            broker_endpoint, "--ready-file", (logs / "web.ready").string()},
                    .log_file = logs / "web.log"};
     for (auto& arg : telemetry::DdsArguments(options.dds))
       web.args.push_back(std::move(arg));

@@ -9,7 +9,7 @@ const FAULT_KINDS = ["HEARTBEAT_LOSS", "BUS_OFF", "ERROR_PASSIVE", "RPDO_TIMEOUT
 
 // Everything the page knows; tests read it (window.canfleet).
 const fleet = {
-  nodes: [], byKey: {}, buses: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
+  nodes: [], byKey: {}, diag: {}, buses: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
   retention: 600, now: 0,
   selected: null, plotted: [], span: 60, messages: 0, bytes: 0, connected: false,
 };
@@ -26,6 +26,7 @@ function apply(msg) {
   for (const n of msg.nodes) fleet.byKey[n.key] = n;
   fleet.nodes = Object.values(fleet.byKey).sort((a, b) => a.bus.localeCompare(b.bus) || a.id - b.id);
   if (msg.series) fleet.seriesNames = msg.series;
+  if (msg.diag) for (const [key, d] of Object.entries(msg.diag)) { fleet.diag[key] = d; const r = rows.get(key); if (r) r.node = null; }
   fleet.buses = msg.buses;
   fleet.scenarios = msg.scenarios;
   for (const e of msg.events) {
@@ -147,13 +148,19 @@ function renderOverview() {
       row.node = n;
       row.tr.classList.toggle("faulted", n.faulted);
       row.tr.classList.toggle("stale", n.stale || !n.alive);
+      const d = fleet.diag[n.key];
       const cells = [n.bus, n.id, n.name, n.device, n.nmt, n.controller, n.tec, n.rec, n.error_register + "h",
         n.heartbeat_ms ? n.heartbeat_ms + " ms" : "off", "",
-        n.last_emcy ? `${n.last_emcy.code}h (${n.last_emcy.register}h)` : ""];
+        n.last_emcy ? `${n.last_emcy.code}h (${n.last_emcy.register}h)` : "",
+        d && d.hb_min_ms !== null ? `${fmt(d.hb_min_ms)}–${fmt(d.hb_max_ms)} ms ±${fmt(d.hb_jitter_ms ?? 0)}` : "",
+        d && d.sdo_min_ms !== null ? `${fmt(d.sdo_min_ms)}–${fmt(d.sdo_max_ms)} ms (${d.sdo_responses})` : "",
+        d ? String(d.bootups) : ""];
       row.tr.replaceChildren(...cells.map((c, i) => {
         const td = el("td", {}, String(c));
         if (i === 4) { td.className = "state-" + n.nmt; td.setAttribute("data-field", "nmt"); }
         if (i === 8) td.setAttribute("data-field", "error-register");
+        if (i === 12) td.setAttribute("data-field", "heartbeat-period");
+        if (i === 13) td.setAttribute("data-field", "sdo-time");
         return td;
       }));
       row.age = row.tr.children[10];
@@ -218,6 +225,7 @@ function renderDetail() {
   document.getElementById("detail-title").textContent = n ? `${n.name || n.bus + " #" + n.id} (${n.device})` : "(click a row)";
   box.replaceChildren();
   if (!n) return;
+  if (n.diag) box.appendChild(el("p", { class: "muted" }, `heartbeats ${n.diag.heartbeats} (period ${fmt(n.diag.hb_min_ms ?? 0)}–${fmt(n.diag.hb_max_ms ?? 0)} ms, jitter ${fmt(n.diag.hb_jitter_ms ?? 0)} ms), boot-ups ${n.diag.bootups}, SDO answers ${n.diag.sdo_responses} in ${fmt(n.diag.sdo_min_ms ?? 0)}–${fmt(n.diag.sdo_max_ms ?? 0)} ms (${n.diag.sdo_aborts} aborts), EMCYs ${n.diag.emcys}`));
   box.appendChild(el("p", { class: "muted" }, `uptime ${n.uptime_s.toFixed(0)} s, RPDOs ${n.rpdo}, TPDOs ${n.tpdo}; heartbeat consumers: ${n.consumers.map((c) => `#${c.node} ${c.time_ms} ms ${c.state}`).join(", ") || "none"}`));
   const emcy = el("ol", { class: "emcy" });
   for (const e of n.emcy.slice().reverse()) emcy.appendChild(el("li", {}, `${new Date(e.time * 1000).toLocaleTimeString()} ${e.code}h register ${e.register}h data ${e.data}`));

@@ -32,7 +32,8 @@ def shots(tmp_path: Path) -> Path:
 
 def test_the_page_shows_the_fleet_plots_a_signal_and_injects_a_fault(
         fleet: Fleet, webs: List[Dict[str, object]], browser: Browser, tmp_path: Path) -> None:
-    web = start_web("--listen", "127.0.0.1:0", control=fleet.control, folder=tmp_path)
+    web = start_web("--listen", "127.0.0.1:0", "--broker", str(fleet.broker), control=fleet.control,
+                    folder=tmp_path)
     webs.append(web)
     browser.open(str(web["url"]))
     # Overview: every node of the topology, by name, with its NMT state from its heartbeat.
@@ -42,6 +43,16 @@ def test_the_page_shows_the_fleet_plots_a_signal_and_injects_a_fault(
     browser.wait_for("[...document.querySelectorAll('#overview td[data-field=nmt]')]"
                      ".every(td => td.textContent === 'operational')")
     browser.wait_for("document.querySelector('#buses .bus polyline') !== null")  # bus load over time
+    # CANopen-Diag statistics from the bus (the monitor): quad-5's heartbeat period (100 ms,
+    # pair.textproto) and the orchestrator's SDO answered by quad-5.
+    browser.wait_for("(window.canfleet.diag['can0:5'] || {}).hb_min_ms > 0")
+    diag = browser.js("window.canfleet.diag['can0:5']")
+    # Real time: the figures are the bus's (tests/unit/web checks the arithmetic), not asserted here.
+    assert 0 < diag["hb_min_ms"] <= diag["hb_max_ms"] and diag["heartbeats"] >= 2, diag
+    assert fleet.node("quad-5").sdo_read(0x1017, 0, "u16") == 100
+    browser.wait_for("(window.canfleet.diag['can0:5'] || {}).sdo_responses >= 1")
+    browser.wait_for("document.querySelector('#overview tr[data-name=quad-5] td[data-field=sdo-time]')"
+                     ".textContent.includes('ms')")
 
     # A plot of quad-5's IN1 (Quad manual §3.1.1), chosen with the page's own picker, follows it.
     series = "io:can0:5/IN1.voltage_mV"
