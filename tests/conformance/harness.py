@@ -299,8 +299,25 @@ class NodeUnderTest:
         self.proc = subprocess.Popen(self.command(cli_node_id), stdout=log, stderr=subprocess.STDOUT,
                                      start_new_session=True)
         log.close()
+        self._wait_attached(True)
         if wait and not wait_until(lambda: self._seen(mark, bootup_id), BOOT_TIMEOUT):
             raise AssertionError(f"no boot-up {bootup_id:03X}#00 from {self.variant.name}:\n{tail(self.log)}")
+
+    def _wait_attached(self, attached: bool) -> None:
+        """Virtual time: waits in real time (the fleet stands still meanwhile) until the broker has
+        the node process's connection (or, after a stop, has seen it go). Starting a process takes
+        real time, which the fleet's simulated time must not race: a boot-up wait counted in
+        simulated seconds from before the process connected would run out on a slow machine."""
+        if not self.fleet.virtual:
+            return
+        end = time.monotonic() + STARTUP_TIMEOUT
+        while self.fleet.attached(self.variant.name) != attached:
+            if attached and self.proc is not None and self.proc.poll() is not None:
+                raise AssertionError(f"{self.variant.name} exited with {self.proc.returncode}:\n{tail(self.log)}")
+            if time.monotonic() > end:
+                raise AssertionError(f"{self.variant.name} {'never attached' if attached else 'still attached'} "
+                                     f"within {STARTUP_TIMEOUT:g} s:\n{tail(self.log)}")
+            time.sleep(0.02)
 
     def _seen(self, mark: int, can_id: int) -> bool:
         if self.proc is not None and self.proc.poll() is not None:
@@ -322,6 +339,7 @@ class NodeUnderTest:
                 self.proc.wait()
         code = self.proc.returncode
         self.proc = None
+        self._wait_attached(False)
         return code
 
     def close(self) -> Optional[int]:
