@@ -1,4 +1,5 @@
 #include "orchestrator/fleet/fleet.hpp"
+#include "orchestrator/host/broker_host.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -64,7 +65,14 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
       supervisor_(io, scheduler,
                   Supervisor::Hooks{
                       .started =
-                          [this](const std::string& name, pid_t) {
+                          [this](const std::string& name, pid_t pid) {
+                            // Virtual time waits for the process (real time to start it is no
+                            // simulated time): it joins at the time it was started.
+                            if (options_.conductor != nullptr) {
+                              const std::string clock_id = name + "#" + std::to_string(pid);
+                              awaited_clock_[name] = clock_id;
+                              options_.conductor->HoldUntilProcessJoins(clock_id, host::kJoinTimeout);
+                            }
                             if (const FleetNode* node = FindNode(name)) {
                               for (std::size_t p = 0; p < node->buses.size(); ++p) {
                                 tracker_.Forget(node->buses[p], node->node_ids[p]);
@@ -72,7 +80,13 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
                               }
                             }
                           },
-                      .ended = {},
+                      .ended =
+                          [this](const std::string& name, const std::string&, bool) {
+                            const auto it = awaited_clock_.find(name);
+                            if (it == awaited_clock_.end()) return;
+                            if (options_.conductor != nullptr) options_.conductor->StopWaitingFor(it->second);
+                            awaited_clock_.erase(it);
+                          },
                   }),
       captures_(broker, wall_origin_) {
   for (const auto& spec : options_.topology.node()) {

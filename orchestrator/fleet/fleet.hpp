@@ -209,7 +209,9 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   std::optional<TimePoint> final_origin_;
   std::vector<std::unique_ptr<ScenarioTap>> scenario_taps_;  ///< listen-only, one per bus, for expectations
   bool ready_ = false;
-  std::map<std::uint64_t, std::unique_ptr<AskedExpectation>> asked_;  ///< ExpectRequests being judged
+  std::map<std::uint64_t, std::unique_ptr<AskedExpectation>> asked_;
+  /// Virtual time: each node's latest process ("name#pid"), awaited by the conductor until it joins.
+  std::map<std::string, std::string> awaited_clock_;  ///< ExpectRequests being judged
   std::uint64_t next_asked_ = 1;
 
   std::function<void()> on_ready_;

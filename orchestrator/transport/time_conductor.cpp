@@ -49,6 +49,10 @@ void TimeConductor::Join(GrantedSession& session, const std::string& clock_id, s
   // A process counts once every port it attaches has joined: it powers on when its last port is
   // connected, and time started by its first port would run on (to a scenario's timeout, at the
   // speed of the broker alone) while the others are still on their way.
+  if (const auto it = awaited_.find(clock_id); it != awaited_.end() && p.sessions.size() >= p.ports) {
+    spdlog::debug("virtual time: {} joined; time goes on at {}", clock_id, TimeText(Now()));
+    StopWaitingFor(clock_id);
+  }
   if (join_target_ && JoinedProcesses() >= *join_target_) {
     spdlog::info("virtual time: {} node process(es) joined; time starts at {}", JoinedProcesses(),
                  TimeText(Now()));
@@ -185,6 +189,31 @@ void TimeConductor::HoldUntilJoined(std::size_t processes, std::chrono::millisec
     join_target_.reset();
     Release();
   });
+}
+
+void TimeConductor::HoldUntilProcessJoins(const std::string& clock_id, std::chrono::milliseconds timeout) {
+  if (awaited_.contains(clock_id)) return;
+  if (const auto it = participants_.find(clock_id);
+      it != participants_.end() && it->second.sessions.size() >= it->second.ports)
+    return;  // joined already
+  Hold();
+  auto timer = std::make_unique<asio::steady_timer>(io_, timeout);
+  timer->async_wait(
+      [this, alive = std::weak_ptr<int>(alive_), clock_id, timeout](const asio::error_code& ec) {
+        if (ec || alive.expired() || !awaited_.contains(clock_id)) return;
+        spdlog::warn("virtual time: {} did not join within {} ms (real time); time goes on", clock_id,
+                     timeout.count());
+        StopWaitingFor(clock_id);
+      });
+  awaited_.emplace(clock_id, std::move(timer));
+}
+
+void TimeConductor::StopWaitingFor(const std::string& clock_id) {
+  const auto it = awaited_.find(clock_id);
+  if (it == awaited_.end()) return;
+  it->second->cancel();
+  awaited_.erase(it);
+  Release();
 }
 
 double TimeConductor::Factor() const {

@@ -32,6 +32,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -119,6 +120,13 @@ class TimeConductor {
   /// fleet's nodes all start at the same simulated time, whatever their real start-up order), or
   /// `timeout` of real time has passed (then it says how many joined, and time goes on).
   void HoldUntilJoined(std::size_t processes, std::chrono::milliseconds timeout);
+  /// Holds time until the node process of `clock_id` (Hello.clock_id: "name#pid") has joined on
+  /// every port it attaches, or StopWaitingFor(clock_id), or `timeout` of real time: a process the
+  /// fleet (re)starts while time runs (a restart or power-cycle fault, a crash's restart) joins at
+  /// the simulated time it was started, however long it takes to start in real time.
+  void HoldUntilProcessJoins(const std::string& clock_id, std::chrono::milliseconds timeout);
+  /// The process will not join (it ended before it did).
+  void StopWaitingFor(const std::string& clock_id);
 
   // --- a driver: a test process that runs the fleet's time in steps (python/canfleet) ---
   /// From the next round on, time runs only inside Advance() (until as many Undrive() calls): a
@@ -195,6 +203,8 @@ class TimeConductor {
   asio::steady_timer pace_timer_;
   asio::steady_timer join_timer_;
   std::optional<std::size_t> join_target_;  ///< HoldUntilJoined's count, while it holds
+  /// HoldUntilProcessJoins: the processes awaited, each with its timeout (one Hold each).
+  std::map<std::string, std::unique_ptr<asio::steady_timer>> awaited_;
 
   std::map<std::string, Participant> participants_;  ///< by clock id: stable nodes, ordered names
   std::unordered_map<const GrantedSession*, SessionState> sessions_;

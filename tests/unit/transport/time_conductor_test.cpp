@@ -349,5 +349,29 @@ TEST_F(Conductor, UndriveEndsTheAdvanceAndTimeRunsOnItsOwn) {
   EXPECT_EQ(a.grants.size(), 1u) << "not driven: rounds run without an advance";
 }
 
+// A process the fleet (re)starts while time runs: time waits for it to join (its real start-up is
+// no simulated time), or for the word that it ended first.
+TEST_F(Conductor, TimeWaitsForARestartedProcessToJoin) {
+  FakeNode a("a", conductor, broker);
+  Poll();
+  ASSERT_EQ(a.grants.size(), 1u);
+  conductor.HoldUntilProcessJoins("b#2", std::chrono::milliseconds(60'000));
+  ASSERT_TRUE(a.Reach(500ms));
+  Poll();
+  EXPECT_EQ(a.grants.size(), 1u) << "held until b#2 joins";
+  FakeNode b("b", conductor, broker, "b#2");
+  Poll();
+  EXPECT_EQ(b.grants.size(), 1u);
+  EXPECT_EQ(b.grants[0].first, L) << "it joined where time stood";
+
+  conductor.HoldUntilProcessJoins("c#3", std::chrono::milliseconds(60'000));
+  ASSERT_TRUE(b.Reach(1000ms));
+  Poll();
+  EXPECT_EQ(a.grants.size(), 1u) << "held until c#3 joins";
+  conductor.StopWaitingFor("c#3");  // it ended before it joined
+  Poll();
+  EXPECT_EQ(a.grants.size(), 2u) << "a's deadline (500 ms) is next";
+}
+
 }  // namespace
 }  // namespace canfleet::transport
