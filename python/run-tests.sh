@@ -13,16 +13,11 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/.." && pwd)"
 
-build="$repo/build"
-if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
-  build="$1"
-  shift
-fi
 # shellcheck source=scripts/python-suite.sh
 source "$repo/scripts/python-suite.sh"
-python_suite_setup "python tests" "$build"
+python_suite_setup "python tests" "$@"
 
 cd "$here"
 export CANFLEET_BIN_DIR="$build/bin"
 export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-78}"  # node telemetry off other runs' DDS domain
-exec "$python" -m pytest -p no:cacheprovider "--junitxml=$build/python-junit.xml" "$@"
+exec "$python" -m pytest -p no:cacheprovider "--junitxml=$build/python-junit.xml" "${suite_args[@]}"

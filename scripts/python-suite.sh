@@ -1,13 +1,22 @@
-# Sourced by the Python suites (python/run-tests.sh, tests/conformance/run.sh): what they share
-# before pytest. python_suite_setup LABEL BUILD_DIR checks the build's binaries and gets the venv
-# (scripts/python-env.sh), then sets `build` (absolute) and `python` (the venv's interpreter). Exits
-# 2 when the build is missing, 77 (ctest's SKIP_RETURN_CODE) when PyPI cannot be reached for the
+# Sourced by the Python suites (python/run-tests.sh, tests/conformance/run.sh, tests/system/web/run.sh):
+# what they share before pytest. python_suite_setup LABEL [BUILD_DIR] [PYTEST_ARGS...] takes the
+# build folder (the first argument when it is not an option; default the repository's build/),
+# checks the build's binaries and gets the venv (scripts/python-env.sh), then sets `build`
+# (absolute), `python` (the venv's interpreter) and `suite_args` (the rest, for pytest). Exits 2
+# when the build is missing, 77 (ctest's SKIP_RETURN_CODE) when PyPI cannot be reached for the
 # venv (python-env.sh exit 75, the machine's limit), 1 when the venv fails otherwise (our package
 # does not build: a failure, never a skip).
 python_suite_setup() {
-  local label=$1 tool env_status=0 env_out repo
+  local label=$1 tool env_status=0 env_out repo given
+  shift
   repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-  build="$(cd "$2" 2>/dev/null && pwd)" || { echo "$label: no build folder '$2'" >&2; exit 2; }
+  given="$repo/build"
+  if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
+    given="$1"
+    shift
+  fi
+  suite_args=("$@")
+  build="$(cd "$given" 2>/dev/null && pwd)" || { echo "$label: no build folder '$given'" >&2; exit 2; }
   for tool in canfleet canfleet-node; do
     if [ ! -x "$build/bin/$tool" ]; then
       echo "$label: $build/bin/$tool is missing (build the project first)" >&2

@@ -14,14 +14,9 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../.." && pwd)"
 
-build="$repo/build"
-if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
-  build="$1"
-  shift
-fi
 # shellcheck source=scripts/python-suite.sh
 source "$repo/scripts/python-suite.sh"
-python_suite_setup "conformance" "$build"
+python_suite_setup "conformance" "$@"
 
 cd "$here"
 echo "conformance: $("$python" -c 'import canopen, can; print(f"python-canopen {canopen.__version__}, python-can {can.__version__}")'), binaries from $build/bin"
@@ -29,7 +24,7 @@ export CANFLEET_BUILD_DIR="$build"
 # Virtual time unless the arguments say otherwise (--canfleet-time real: the wall-clock suite,
 # python-canopen over socketcand).
 time_mode=(--canfleet-time virtual)
-for arg in "$@"; do
+for arg in "${suite_args[@]}"; do
   case "$arg" in --canfleet-time*) time_mode=() ;; esac
 done
-exec "$python" -m pytest "--build-dir=$build" "${time_mode[@]}" "$@"
+exec "$python" -m pytest "--build-dir=$build" "${time_mode[@]}" "${suite_args[@]}"

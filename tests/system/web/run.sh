@@ -8,16 +8,11 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../../.." && pwd)"
-build="$repo/build"
-if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
-  build="$1"
-  shift
-fi
 # shellcheck source=scripts/python-suite.sh
 source "$repo/scripts/python-suite.sh"
-python_suite_setup "web tests" "$build"
+python_suite_setup "web tests" "$@"
 cd "$here"
 export CANFLEET_BIN_DIR="$build/bin"
 export CANFLEET_WEB_SHOTS="$build/web-screenshots"
 export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-93}"
-exec "$python" -m pytest -p no:cacheprovider -rs "--junitxml=$build/web-junit.xml" "$@" .
+exec "$python" -m pytest -p no:cacheprovider -rs "--junitxml=$build/web-junit.xml" "${suite_args[@]}" .
