@@ -63,7 +63,14 @@ async function refreshDetail() {
   if (fleet.selected) {
     try {
       const res = await fetch("/api/node?key=" + fleet.selected);
-      fleet.detail = await res.json();
+      const detail = await res.json();
+      const emcys = detail && detail.emcy ? detail.emcy.length : 0;
+      if (detail && detail.summary && detail.summary.name && fleet.info && fleet.info.actions &&
+          (fleet.lastRead1003 !== fleet.selected + "/" + emcys)) {
+        fleet.lastRead1003 = fleet.selected + "/" + emcys;
+        read1003(detail.summary.name);
+      }
+      fleet.detail = detail;
       scheduleRender();
     } catch (e) { /* the next try */ }
   }
@@ -208,8 +215,10 @@ function renderBuses() {
       div.append(el("div", { class: "summary" }), svgEl("svg", { width: "100%", height: "90" }));
       box.appendChild(div);
     }
+    const loads = (fleet.series[`bus:${b.name}/load`] || []).map((p) => p[1]);
+    const peak = loads.length ? Math.max(...loads) : 0;
     div.querySelector(".summary").textContent =
-      `${b.name}: ${(b.bitrate / 1000) || "?"} kbit/s, load ${fmt(b.load ?? 0)} %, ${fmt(b.fps ?? 0)} frames/s, ` +
+      `${b.name}: ${(b.bitrate / 1000) || "?"} kbit/s, load ${fmt(b.load ?? 0)} % (peak ${fmt(peak)} %), ${fmt(b.fps ?? 0)} frames/s, ` +
       `${b.error_frames ?? 0} error frames, ${b.nodes ?? 0} ports` + (b.faults.length ? `, ${b.faults.length} fault(s)` : "");
     lineChart(div.querySelector("svg"), [
       { name: `bus:${b.name}/load`, color: COLORS[0], points: fleet.series[`bus:${b.name}/load`] || [] },
@@ -218,6 +227,25 @@ function renderBuses() {
 }
 
 let refreshNow = () => {};
+
+// The node's pre-defined error field (1003h, CiA 301 §7.5.2.5), read by SDO through the control API
+// when the node is selected or its EMCY count changes.
+async function read1003(name) {
+  const read = async (sub, type) => {
+    const r = await action({ sdo_read: { node: name, index: 0x1003, subindex: sub, type } });
+    if (!r.ok) throw new Error(r.error);
+    return r.response.sdo.text;
+  };
+  try {
+    const count = Number(await read(0, "u8"));
+    const entries = [];
+    for (let sub = 1; sub <= Math.min(count, 16); sub++) entries.push(await read(sub, "u32"));
+    fleet.errorField = { name, entries, error: "" };
+  } catch (e) {
+    fleet.errorField = { name, entries: [], error: e.message };
+  }
+  scheduleRender();
+}
 function renderDetail() {
   const box = document.getElementById("detail");
   const d = fleet.detail && fleet.detail.summary && nodeKey(fleet.detail.summary) === fleet.selected ? fleet.detail : null;
@@ -242,6 +270,10 @@ function renderDetail() {
     tr.appendChild(td);
     io.appendChild(tr);
   }
+  const ef = fleet.errorField;
+  const efText = !ef || ef.name !== n.name ? "1003h: reading..." : ef.error ? `1003h: ${ef.error}`
+    : `1003h: ${ef.entries.length} error(s)${ef.entries.length ? ": " + ef.entries.map((v) => "0x" + Number(v).toString(16).toUpperCase().padStart(8, "0")).join(", ") : ""}`;
+  box.appendChild(el("p", { class: "error-field", "data-field": "1003h" }, efText));
   const scroll = el("div", { class: "scroll" });
   scroll.appendChild(io);
   box.appendChild(scroll);
@@ -372,6 +404,7 @@ function setup() {
     scheduleRender();
   });
   window.canfleetActions = { action, addPlot, plotCsv };
+  fetch("/api/info").then((r) => r.json()).then((info) => { fleet.info = info; });
   refreshNow = () => { fetch("/api/node?key=" + fleet.selected).then((r) => r.json()).then((d) => { fleet.detail = d; scheduleRender(); }); };
   connect();
   refreshDetail();

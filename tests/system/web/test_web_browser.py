@@ -81,6 +81,9 @@ def test_the_page_shows_the_fleet_plots_a_signal_and_injects_a_fault(
                      ".textContent !== '00h'")
     browser.js("document.querySelector('#overview tr[data-name=quad-6]').click(); true")
     browser.wait_for("document.getElementById('detail').textContent.includes('8130h')")
+    # Its 1003h (CiA 301 §7.5.2.5), read by SDO from the page: the Quad's entry for a lost
+    # heartbeat of node 5 (Quad manual §4.1: (description 08h << 8 | channel 05h) << 16 | 8130h).
+    browser.wait_for("document.querySelector('#detail [data-field=\"1003h\"]').textContent.includes('0x08058130')")
     browser.wait_for("document.querySelectorAll('#faults li').length === 1")
     browser.screenshot(shots(tmp_path) / "web-fault.png")
 
