@@ -179,6 +179,21 @@ void WebState::Apply(const telemetry::NodeStatusSample& s, const telemetry::Samp
   std::lock_guard lock(mutex_);
   view_.Apply(s, m, &scratch_);
   Record(scratch_);
+  if (!m.valid_data) return;
+  // The controller's state over time (0 error-active, 1 error-passive, 2 bus-off) and its counters.
+  const std::string prefix = "node:" + s.bus + ":" + std::to_string(int{s.node_id}) + "/";
+  const auto sim = simulated_.find(s.bus);
+  const double simulated = sim == simulated_.end() ? -1 : sim->second;
+  // Kept when they change only: a status comes every second from every node, and these rarely move.
+  for (const auto& [name, value] : {std::pair{"controller", static_cast<double>(s.controller_state)},
+                                    std::pair{"TEC", static_cast<double>(s.tec)},
+                                    std::pair{"REC", static_cast<double>(s.rec)}}) {
+    std::string series = prefix + name;
+    const auto last = last_value_.find(series);
+    if (last != last_value_.end() && last->second == value) continue;
+    last_value_[series] = value;
+    AddPoint(m.source_time, simulated, std::move(series), value);
+  }
 }
 
 void WebState::Apply(const telemetry::EmcySample& s, const telemetry::SampleMeta& m) {

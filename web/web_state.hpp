@@ -106,6 +106,7 @@ class WebState {
   std::map<std::string, double> simulated_;
   std::set<std::string> series_names_;  ///< every series seen (the page's picker)
   DiagStats diag_;
+  std::map<std::string, double> last_value_;  ///< series kept on change only: their last value
 };
 
 /// `text` with every byte that is not part of valid UTF-8 replaced by U+FFFD.

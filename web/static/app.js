@@ -200,7 +200,9 @@ function lineChart(svg, series, opts) {
   svg.appendChild(svgEl("text", { x: w - pad.r - 60, y: h - 3 }, `last ${Math.round(t1 - t0)} s`));
   if (!isFinite(t0)) return;
   for (const s of series) {
-    const pts = s.points.filter((p) => p[0] >= t0).map((p) => `${x(p[0]).toFixed(1)},${y(p[1]).toFixed(1)}`);
+    // Hold the last value up to now (series kept on change only: controller states, polled objects).
+    const held = s.points.length ? [...s.points, [t1, s.points[s.points.length - 1][1]]] : [];
+    const pts = held.filter((p) => p[0] >= t0).map((p) => `${x(p[0]).toFixed(1)},${y(p[1]).toFixed(1)}`);
     if (pts.length) svg.appendChild(svgEl("polyline", { points: pts.join(" "), fill: "none", stroke: s.color, "stroke-width": 1.5, "data-series": s.name }));
   }
 }
@@ -320,7 +322,7 @@ function renderTimeline() {
 
 function renderPlotPicker() {
   const pick = document.getElementById("series-pick");
-  const names = fleet.seriesNames;
+  const names = fleet.seriesNames.filter((n) => !n.startsWith("sdo:"));
   if (pick.options.length === names.length) return;
   const chosen = pick.value;
   pick.replaceChildren(...names.map((n) => el("option", { value: n }, n)));
@@ -343,6 +345,30 @@ function renderPlot() {
     span.style.color = s.color;
     return span;
   }));
+}
+
+// Objects plotted by SDO upload through the control API, once a second each (the page's own
+// polling: "sdo:quad-5/1017h.0").
+const polled = new Map();
+function addObject(node, index, sub, type) {
+  const name = `sdo:${node}/${index.toString(16).toUpperCase().padStart(4, "0")}h.${sub}`;
+  if (!polled.has(name)) {
+    polled.set(name, { node, index, sub, type: type || "u32" });
+    if (!fleet.seriesNames.includes(name)) fleet.seriesNames = [...fleet.seriesNames, name].sort();
+  }
+  addPlot(name);
+  return name;
+}
+async function pollObjects() {
+  for (const [name, o] of polled) {
+    if (!fleet.plotted.includes(name)) continue;
+    try {
+      const r = await action({ sdo_read: { node: o.node, index: o.index, subindex: o.sub, type: o.type } });
+      if (r.ok) (fleet.series[name] ||= []).push([fleet.now, Number(r.response.sdo.text), -1]);
+    } catch (e) { /* the next round */ }
+  }
+  scheduleRender();
+  setTimeout(pollObjects, 1000);
 }
 
 function plotCsv() {
@@ -403,7 +429,12 @@ function setup() {
     fleet.span = Math.max(5, Math.round((fleet.span || fleet.retention) * (ev.deltaY > 0 ? 1.25 : 0.8)));
     scheduleRender();
   });
-  window.canfleetActions = { action, addPlot, plotCsv };
+  window.canfleetActions = { action, addPlot, addObject, plotCsv };
+  document.getElementById("object-add").onclick = () => {
+    const [node, index, sub, type] = document.getElementById("object-pick").value.trim().split(/\s+/);
+    if (node && index) addObject(node, parseInt(index, 16), Number(sub || 0), type);
+  };
+  pollObjects();
   fetch("/api/info").then((r) => r.json()).then((info) => { fleet.info = info; });
   refreshNow = () => { fetch("/api/node?key=" + fleet.selected).then((r) => r.json()).then((d) => { fleet.detail = d; scheduleRender(); }); };
   connect();

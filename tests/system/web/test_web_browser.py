@@ -63,6 +63,13 @@ def test_the_page_shows_the_fleet_plots_a_signal_and_injects_a_fault(
     fleet.node("quad-5").io_set("IN1.voltage_mV", 2500)
     browser.wait_for(f"(window.canfleet.series['{series}'] || []).some(p => p[1] === 2500)")
     browser.wait_for(f"document.querySelector('#plot polyline[data-series=\"{series}\"]') !== null")
+    # An object, polled by SDO from the page: quad-5's heartbeat time (1017h, CiA 301 §7.5.2.31).
+    browser.js("document.getElementById('object-pick').value = 'quad-5 1017 0 u16';"
+               "document.getElementById('object-add').click(); true")
+    browser.wait_for("(window.canfleet.series['sdo:quad-5/1017h.0'] || []).some(p => p[1] === 100)")
+    fleet.node("quad-5").sdo_write(0x1017, 0, 250, "u16")
+    browser.wait_for("(window.canfleet.series['sdo:quad-5/1017h.0'] || []).some(p => p[1] === 250)")
+    fleet.node("quad-5").sdo_write(0x1017, 0, 100, "u16")
     csv_rows = browser.js("window.canfleetActions.plotCsv()")
     assert csv_rows >= 2
     browser.screenshot(shots(tmp_path) / "web-plot.png")
@@ -85,6 +92,9 @@ def test_the_page_shows_the_fleet_plots_a_signal_and_injects_a_fault(
     # heartbeat of node 5 (Quad manual §4.1: (description 08h << 8 | channel 05h) << 16 | 8130h).
     browser.wait_for("document.querySelector('#detail [data-field=\"1003h\"]').textContent.includes('0x08058130')")
     browser.wait_for("document.querySelectorAll('#faults li').length === 1")
+    # quad-6's controller state over time is a series too (plotted on demand): error-active, 0.
+    browser.js("window.canfleetActions.addPlot('node:can0:6/controller'); true")
+    browser.wait_for("(window.canfleet.series['node:can0:6/controller'] || []).some(p => p[1] === 0)")
     browser.screenshot(shots(tmp_path) / "web-fault.png")
 
     # A refusal comes back with the orchestrator's own message, as the CLI prints it.

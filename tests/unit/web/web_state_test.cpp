@@ -124,9 +124,12 @@ TEST(WebState, TheRetentionWindowBoundsWhatIsKept) {
   for (std::uint8_t id = 1; id <= 5; ++id)
     state.Apply(Status(id, "n" + std::to_string(id)), At(kStart + 99s));
   EXPECT_EQ(state.EventCount(), 3u) << "at most max_events";
-  EXPECT_EQ(state.PointCount(), 300u);
+  EXPECT_EQ(state.PointCount(), 300u + 5u * 3u) << "bus statistics; each node's controller, TEC, REC";
+  for (std::uint8_t id = 1; id <= 5; ++id)
+    state.Apply(Status(id, "n" + std::to_string(id)), At(kStart + 99s));
+  EXPECT_EQ(state.PointCount(), 315u) << "controller state and counters are kept when they change only";
   state.Trim(kStart + 100s);
-  EXPECT_EQ(state.PointCount(), 3u * 60u) << "the samples of the last 60 s (40..99)";
+  EXPECT_EQ(state.PointCount(), 3u * 60u + 15u) << "the samples of the last 60 s (40..99)";
 }
 
 TEST(WebState, NamesWithQuotesAndControlCharactersStayValidJson) {
