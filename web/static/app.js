@@ -9,7 +9,7 @@ const FAULT_KINDS = ["HEARTBEAT_LOSS", "BUS_OFF", "ERROR_PASSIVE", "RPDO_TIMEOUT
 
 // Everything the page knows; tests read it (window.canfleet).
 const fleet = {
-  nodes: [], byKey: {}, diag: {}, buses: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
+  nodes: [], byKey: {}, diag: {}, buses: [], virtual: false, clockPairs: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
   retention: 600, now: 0,
   selected: null, plotted: [], span: 60, messages: 0, bytes: 0, connected: false,
 };
@@ -34,8 +34,16 @@ function apply(msg) {
     fleet.events.push(e);
   }
   if (fleet.events.length > 5000) fleet.events.splice(0, fleet.events.length - 5000);
+  fleet.virtual = fleet.buses.some((b) => b.mode === "virtual");
   for (const [t, name, value, simulated] of msg.points) {
     (fleet.series[name] ||= []).push([t, value, simulated]);
+    // The buses' (wall, simulated) pairs: in virtual time every time on the page is drawn in
+    // simulated seconds, those without one of their own (events, polled objects) by interpolation.
+    if (simulated >= 0 && name.startsWith("bus:") && name.endsWith("/load")) {
+      const last = fleet.clockPairs[fleet.clockPairs.length - 1];
+      if (!last || t > last[0]) fleet.clockPairs.push([t, simulated]);
+      if (fleet.clockPairs.length > 2000) fleet.clockPairs.splice(0, 1000);
+    }
   }
   const oldest = fleet.now - fleet.retention;
   for (const points of Object.values(fleet.series)) {
@@ -179,16 +187,32 @@ function renderOverview() {
   if (added) body.replaceChildren(...fleet.nodes.map((n) => rows.get(n.key).tr));
 }
 
+// The simulated time of a wall-clock time (virtual time), from the buses' pairs.
+function simOf(wall) {
+  const pairs = fleet.clockPairs;
+  if (!pairs.length) return wall;
+  let i = pairs.length - 1;
+  while (i > 0 && pairs[i][0] > wall) i--;
+  const [w0, s0] = pairs[i];
+  const next = pairs[i + 1] || pairs[i - 1];
+  const factor = next && next[0] !== w0 ? (next[1] - s0) / (next[0] - w0) : 1;
+  return Math.max(0, s0 + (wall - w0) * factor);
+}
+// A time on the page's axes: simulated seconds in virtual time, else wall-clock seconds.
+const axis = (wall, simulated) => !fleet.virtual ? wall : simulated >= 0 ? simulated : simOf(wall);
+const axisUnit = () => fleet.virtual ? "s simulated" : "s";
+const timeText = (wall) => fleet.virtual ? `t=${simOf(wall).toFixed(3)} s` : new Date(wall * 1000).toLocaleTimeString();
+
 function lineChart(svg, series, opts) {
   // series: [{points: [[t, v]], color, name}]; x: time from t0 to t1
   const w = svg.clientWidth || 500, h = Number(svg.getAttribute("height"));
   svg.replaceChildren();
   const pad = { l: 40, r: 8, t: 6, b: 16 };
   // From the first point kept (at least 10 s back), at most `span` back: a young fleet fills the chart.
-  const first = Math.min(...series.flatMap((s) => s.points.map((p) => p[0])), Infinity);
-  const t1 = fleet.now, t0 = Math.min(t1 - 10, Math.max(opts.span ? t1 - opts.span : -Infinity, first));
+  const first = Math.min(...series.flatMap((s) => s.points.map((p) => axis(p[0], p[2]))), Infinity);
+  const t1 = axis(fleet.now, -1), t0 = Math.min(t1 - 10, Math.max(opts.span ? t1 - opts.span : -Infinity, first));
   let lo = Infinity, hi = -Infinity;
-  for (const s of series) for (const [t, v] of s.points) if (t >= t0) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+  for (const s of series) for (const p of s.points) if (axis(p[0], p[2]) >= t0) { lo = Math.min(lo, p[1]); hi = Math.max(hi, p[1]); }
   if (!isFinite(lo)) { lo = 0; hi = 1; }
   if (opts.zero) lo = Math.min(lo, 0);
   if (hi === lo) hi = lo + 1;
@@ -197,11 +221,12 @@ function lineChart(svg, series, opts) {
   svg.appendChild(svgEl("line", { x1: pad.l, y1: h - pad.b, x2: w - pad.r, y2: h - pad.b, stroke: "#ccd" }));
   svg.appendChild(svgEl("text", { x: 2, y: pad.t + 8 }, fmt(hi)));
   svg.appendChild(svgEl("text", { x: 2, y: h - pad.b }, fmt(lo)));
-  svg.appendChild(svgEl("text", { x: w - pad.r - 60, y: h - 3 }, `last ${Math.round(t1 - t0)} s`));
+  svg.appendChild(svgEl("text", { x: w - pad.r - 110, y: h - 3, "data-axis": axisUnit() }, `last ${Math.round(t1 - t0)} ${axisUnit()}`));
   if (!isFinite(t0)) return;
   for (const s of series) {
     // Hold the last value up to now (series kept on change only: controller states, polled objects).
-    const held = s.points.length ? [...s.points, [t1, s.points[s.points.length - 1][1]]] : [];
+    const held = s.points.map((p) => [axis(p[0], p[2]), p[1]]);
+    if (held.length) held.push([t1, held[held.length - 1][1]]);
     const pts = held.filter((p) => p[0] >= t0).map((p) => `${x(p[0]).toFixed(1)},${y(p[1]).toFixed(1)}`);
     if (pts.length) svg.appendChild(svgEl("polyline", { points: pts.join(" "), fill: "none", stroke: s.color, "stroke-width": 1.5, "data-series": s.name }));
   }
@@ -258,7 +283,7 @@ function renderDetail() {
   if (n.diag) box.appendChild(el("p", { class: "muted" }, `heartbeats ${n.diag.heartbeats} (period ${fmt(n.diag.hb_min_ms ?? 0)}–${fmt(n.diag.hb_max_ms ?? 0)} ms, jitter ${fmt(n.diag.hb_jitter_ms ?? 0)} ms), boot-ups ${n.diag.bootups}, SDO answers ${n.diag.sdo_responses} in ${fmt(n.diag.sdo_min_ms ?? 0)}–${fmt(n.diag.sdo_max_ms ?? 0)} ms (${n.diag.sdo_aborts} aborts), EMCYs ${n.diag.emcys}`));
   box.appendChild(el("p", { class: "muted" }, `uptime ${n.uptime_s.toFixed(0)} s, RPDOs ${n.rpdo}, TPDOs ${n.tpdo}; heartbeat consumers: ${n.consumers.map((c) => `#${c.node} ${c.time_ms} ms ${c.state}`).join(", ") || "none"}`));
   const emcy = el("ol", { class: "emcy" });
-  for (const e of n.emcy.slice().reverse()) emcy.appendChild(el("li", {}, `${new Date(e.time * 1000).toLocaleTimeString()} ${e.code}h register ${e.register}h data ${e.data}`));
+  for (const e of n.emcy.slice().reverse()) emcy.appendChild(el("li", {}, `${timeText(e.time)} ${e.code}h register ${e.register}h data ${e.data}`));
   box.append(el("div", {}, n.emcy.length ? "EMCY history (newest first):" : "no EMCY"), emcy);
   const io = el("table", { class: "io" });
   io.appendChild(el("tr")).append(el("th", {}, "signal"), el("th", {}, "value"), el("th", {}, ""));
@@ -296,8 +321,8 @@ function renderTimeline() {
   const w = svg.clientWidth || 800, h = Number(svg.getAttribute("height"));
   svg.replaceChildren();
   const lanes = [...new Set(fleet.events.map((e) => e.bus || "fleet"))].sort();
-  const t1 = fleet.now;
-  const first = Math.min(...fleet.events.map((e) => e.t), Infinity);
+  const t1 = axis(fleet.now, -1);
+  const first = Math.min(...fleet.events.map((e) => axis(e.t, -1)), Infinity);
   const t0 = Math.min(t1 - 10, Math.max(fleet.span ? t1 - fleet.span : -Infinity, first));
   const x = (t) => 60 + (t - t0) / (t1 - t0) * (w - 70);
   const laneH = Math.max(14, (h - 16) / Math.max(1, lanes.length));
@@ -307,16 +332,17 @@ function renderTimeline() {
   });
   const kindColor = { emcy: "#c62828", fault: "#6a1b9a", verdict: "#1565c0", nmt: "#ef6c00", controller: "#00838f" };
   for (const e of fleet.events) {
-    if (e.t < t0) continue;
+    const et = axis(e.t, -1);
+    if (et < t0) continue;
     const lane = lanes.indexOf(e.bus || "fleet");
-    const c = svgEl("circle", { cx: x(e.t), cy: 8 + (lane + 0.5) * laneH, r: 4, fill: kindColor[e.type] || "#78909c", "data-type": e.type });
+    const c = svgEl("circle", { cx: x(et), cy: 8 + (lane + 0.5) * laneH, r: 4, fill: kindColor[e.type] || "#78909c", "data-type": e.type });
     c.appendChild(svgEl("title", {}, eventText(e)));
     svg.appendChild(c);
   }
   const list = document.getElementById("events");
   list.replaceChildren();
   for (const e of fleet.events.slice(-60).reverse()) {
-    list.appendChild(el("li", { class: e.type, "data-type": e.type }, `${new Date(e.t * 1000).toLocaleTimeString()} ${eventText(e)}`));
+    list.appendChild(el("li", { class: e.type, "data-type": e.type }, `${timeText(e.t)} ${eventText(e)}`));
   }
 }
 

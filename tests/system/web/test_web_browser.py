@@ -119,3 +119,30 @@ def test_the_page_of_a_read_only_server_refuses_actions(
     result = browser.js("window.canfleetActions.action({fault_clear: {}})")
     assert result == {"ok": False, "error": "read-only: actions are off (--read-only)"}
     assert json.loads(browser.js("fetch('/api/info').then(r => r.text())"))["read_only"] is True
+
+
+def test_in_virtual_time_the_page_counts_simulated_seconds(browser: Browser, tmp_path: Path) -> None:
+    # `canfleet up --time virtual --speed 4 --web`: a fleet in virtual time, paced for a person.
+    import subprocess
+    import time
+    from canfleet.fleet import find_binaries
+    from conftest import PAIR
+    up = subprocess.Popen([str(find_binaries() / "canfleet"), "up", str(PAIR), "--time", "virtual", "--speed", "4",
+                           "--control", "tcp://127.0.0.1:0", "--listen", f"unix://{tmp_path / 'b.sock'}",
+                           "--ready-file", str(tmp_path / "ready"), "--state-dir", str(tmp_path / "nodes"),
+                           "--web", "127.0.0.1:0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        web_ready = tmp_path / "nodes" / "logs" / "web.ready"
+        end = time.monotonic() + 60
+        while not web_ready.exists() and time.monotonic() < end:
+            time.sleep(0.1)
+        browser.open(web_ready.read_text().split()[1])
+        browser.wait_for("document.querySelectorAll('#overview tbody tr').length === 3")
+        browser.wait_for("document.getElementById('clock').textContent.startsWith('virtual time')")
+        browser.wait_for("window.canfleet.clockPairs.length >= 2")
+        browser.wait_for("document.querySelector('#buses text[data-axis]').textContent.endsWith('s simulated')")
+        browser.wait_for("[...document.querySelectorAll('#events li')].some(li => li.textContent.startsWith('t='))")
+        browser.screenshot(shots(tmp_path) / "web-virtual.png")
+    finally:
+        up.terminate()
+        assert up.wait(timeout=60) == 0
