@@ -185,9 +185,9 @@ void WebState::Apply(const telemetry::NodeStatusSample& s, const telemetry::Samp
   const auto sim = simulated_.find(s.bus);
   const double simulated = sim == simulated_.end() ? -1 : sim->second;
   // Kept when they change only: a status comes every second from every node, and these rarely move.
-  for (const auto& [name, value] : {std::pair{"controller", static_cast<double>(s.controller_state)},
-                                    std::pair{"TEC", static_cast<double>(s.tec)},
-                                    std::pair{"REC", static_cast<double>(s.rec)}}) {
+  for (const auto& [name, value] :
+       {std::pair{"controller", static_cast<double>(s.controller_state)},
+        std::pair{"TEC", static_cast<double>(s.tec)}, std::pair{"REC", static_cast<double>(s.rec)}}) {
     std::string series = prefix + name;
     const auto last = last_value_.find(series);
     if (last != last_value_.end() && last->second == value) continue;

@@ -70,13 +70,15 @@ TEST(WebState, TheFirstUpdateCarriesEverythingAndTheNextOnlyWhatIsNew) {
   state.Apply(changed, At(kStart + 5s));
   const auto third = Parse(state.UpdateJson(cursor, kStart + 6s));
   ASSERT_EQ(Count(third, "nodes"), 1u);
-  EXPECT_EQ(third.fields().at("nodes").list_value().values(0).struct_value().fields().at("nmt").string_value(),
-            "pre-operational");
+  EXPECT_EQ(
+      third.fields().at("nodes").list_value().values(0).struct_value().fields().at("nmt").string_value(),
+      "pre-operational");
 
   // The node view asks for one node in full: its EMCY history among the rest.
   const auto detail = Parse(state.NodeJson("can0", 5, kStart + 6s));
-  EXPECT_EQ(detail.fields().at("emcy").list_value().values(0).struct_value().fields().at("code").string_value(),
-            "8130");
+  EXPECT_EQ(
+      detail.fields().at("emcy").list_value().values(0).struct_value().fields().at("code").string_value(),
+      "8130");
   EXPECT_EQ(state.NodeJson("can0", 99, kStart + 6s), "null");
 }
 
@@ -145,7 +147,10 @@ TEST(WebState, NamesWithQuotesAndControlCharactersStayValidJson) {
 // U+FFFD, so one odd name cannot cut every page off.
 TEST(WebState, InvalidUtf8FromAPublisherBecomesReplacementCharacters) {
   EXPECT_EQ(ValidUtf8("quad-5 \xC3\xA9"), "quad-5 \xC3\xA9") << "valid UTF-8 stays";
-  EXPECT_EQ(ValidUtf8("a\xFF" "b"), "a\xEF\xBF\xBD" "b");
+  EXPECT_EQ(ValidUtf8("a\xFF"
+                      "b"),
+            "a\xEF\xBF\xBD"
+            "b");
   EXPECT_EQ(ValidUtf8("\xC0\xAF"), "\xEF\xBF\xBD\xEF\xBF\xBD") << "overlong";
   EXPECT_EQ(ValidUtf8("\xED\xA0\x80"), "\xEF\xBF\xBD\xEF\xBF\xBD\xEF\xBF\xBD") << "a surrogate";
   EXPECT_EQ(ValidUtf8("\xE2\x82"), "\xEF\xBF\xBD\xEF\xBF\xBD") << "cut short";
