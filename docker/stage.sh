@@ -2,7 +2,8 @@
 # Build stage of docker/Dockerfile: builds the shipped executables and stages what the runtime
 # image holds under OUT:
 #   OUT/bin/                    every executable named `canfleet` or `canfleet-*` (stripped)
-#   OUT/share/canfleet/         topologies/, devices/<variant>/<variant>.eds (canfleet-node --write-eds), telemetry/*.xml
+#   OUT/share/canfleet/         topologies/, devices/<variant>/<variant>.eds (canfleet-node --write-eds), telemetry/*.xml,
+#                               web/ (canfleet web's page)
 #   OUT/etc/canfleet/           telemetry/*.xml again (the Cyclone DDS configs)
 #   OUT/runtime-packages.txt    the Debian packages owning the shared libraries they link
 # Shipped executables follow the naming convention `canfleet[-<name>]` (tests and benchmarks use
@@ -56,6 +57,10 @@ if [ -x "$out/bin/canfleet-node" ]; then
     mkdir -p "$share/devices/$variant"
     "$out/bin/canfleet-node" --device "$variant" --write-eds "$share/devices/$variant/$variant.eds"
   done
+fi
+# canfleet web's page (web/static), found beside the binary (web/run_web.cpp StaticDir).
+if [ -d "$src/web/static" ]; then
+  mkdir -p "$share/web" && cp "$src"/web/static/* "$share/web/"
 fi
 if compgen -G "$src/telemetry/*.xml" >/dev/null; then
   mkdir -p "$share/telemetry" && cp "$src"/telemetry/*.xml "$share/telemetry/" && cp "$src"/telemetry/*.xml "$out/etc/canfleet/"

@@ -46,6 +46,14 @@ std::pair<std::string, std::uint16_t> ParseListen(const std::string& text) {
 
 std::filesystem::path StaticDir(const std::filesystem::path& given) {
   if (!given.empty()) return given;
+  // Installed (the docker image: /usr/local/bin/canfleet, /usr/local/share/canfleet/web), else the
+  // repository this binary was built from.
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = exe.parent_path().parent_path() / "share" / "canfleet" / "web";
+    if (std::filesystem::is_regular_file(installed / "index.html", ec)) return installed;
+  }
   return CANFLEET_WEB_STATIC_DIR;
 }
 

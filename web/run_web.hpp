@@ -32,7 +32,8 @@ void AddWebOptions(CLI::App& app, WebOptions& options);
 int RunWeb(const WebOptions& options);
 /// "ADDR:PORT" or "PORT" → (address, port). Throws std::invalid_argument.
 std::pair<std::string, std::uint16_t> ParseListen(const std::string& text);
-/// Where the page's files are: `given`, else the repository's web/static this binary was built from.
+/// Where the page's files are: `given`, else <prefix>/share/canfleet/web beside an installed binary
+/// (the docker image), else the repository's web/static this binary was built from.
 std::filesystem::path StaticDir(const std::filesystem::path& given);
 
 }  // namespace canfleet::web

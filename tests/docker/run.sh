@@ -256,6 +256,27 @@ if [ "$rows" -ne 5 ]; then
 fi
 pass "DDS telemetry across containers: canfleet-top --once on network $net shows 5 nodes operational"
 
+# canfleet web in a container on the same network: the page's state from the fleet's DDS telemetry
+# (its files from the image, /usr/local/share/canfleet/web); asked with bash's /dev/tcp.
+web_out=$(timeout 120 docker run --rm --network "$net" "$CANFLEET_IMAGE" bash -c '
+  canfleet web --listen 127.0.0.1:8080 --read-only --ready-file /tmp/web.ready >/tmp/web.log 2>&1 &
+  for _ in $(seq 100); do [ -f /tmp/web.ready ] && break; sleep 0.1; done
+  [ -f /tmp/web.ready ] || { cat /tmp/web.log; exit 1; }
+  for _ in $(seq 60); do
+    out=""
+    if exec 3<>/dev/tcp/127.0.0.1/8080; then
+      printf "GET /api/state HTTP/1.0\r\nHost: x\r\n\r\n" >&3
+      out=$(cat <&3)
+      exec 3<&-
+    fi
+    n=$(printf "%s" "$out" | grep -o "\"nmt\":\"operational\"" | wc -l)
+    [ "$n" -ge 5 ] && { echo "operational: $n"; exit 0; }
+    sleep 1
+  done
+  printf "%s\n" "$out" | head -c 2000; cat /tmp/web.log; exit 1' 2>&1) ||
+  { printf '%s\n' "$web_out" >&2; fail "canfleet web in a container on $net did not show the 5 nodes operational"; }
+pass "canfleet web in a container on network $net: /api/state shows the 5 nodes operational (DDS telemetry, the image's page files)"
+
 # ---- socketcand on the host's loopback -----------------------------------------------------------
 # `< hi >` from can0's published port, then a frame in raw mode (socketcand protocol). compose.yaml
 # runs `canfleet up --socketcand-bind 0.0.0.0`: the container's loopback is not where published ports arrive.
