@@ -9,7 +9,7 @@ const FAULT_KINDS = ["HEARTBEAT_LOSS", "BUS_OFF", "ERROR_PASSIVE", "RPDO_TIMEOUT
 
 // Everything the page knows; tests read it (window.canfleet).
 const fleet = {
-  nodes: [], byKey: {}, diag: {}, buses: [], virtual: false, clockPairs: [], scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
+  nodes: [], byKey: {}, diag: {}, buses: [], virtual: false, clockPairs: [], verdicts: {}, scenarios: [], events: [], series: {}, seriesNames: [], detail: null,
   retention: 600, now: 0,
   selected: null, plotted: [], span: 60, messages: 0, bytes: 0, connected: false,
 };
@@ -32,6 +32,8 @@ function apply(msg) {
   for (const e of msg.events) {
     e.t = typeof e.time === "number" ? e.time : Date.parse(e.time) / 1000;  // ISO 8601, as `canfleet watch --json`
     fleet.events.push(e);
+    // The latest verdict of each expectation (the Verdict topic): the scenario panel's rows.
+    if (e.type === "verdict") fleet.verdicts[`${e.scenario}/${String(e.index).padStart(5, "0")}`] = e;
   }
   if (fleet.events.length > 5000) fleet.events.splice(0, fleet.events.length - 5000);
   fleet.virtual = fleet.buses.some((b) => b.mode === "virtual");
@@ -124,7 +126,24 @@ const nodeLabel = (bus, id) => {
   return n && n.name ? n.name : `${bus} #${id}`;
 };
 
+function renderScenario() {
+  const s = fleet.scenarios.find((x) => x.alive) || fleet.scenarios[0];
+  document.getElementById("scenario-line").textContent = s
+    ? `${s.scenario} (${s.source}), cycle ${s.cycle}, ${s.running ? "running" : "done"}: ${s.passed} passed, ` +
+      `${s.failed} failed, ${s.skipped} skipped, ${s.pending} pending${s.step ? "; step " + s.step : ""}` : "(none on the domain)";
+  const body = document.querySelector("#verdicts tbody");
+  const rows = Object.keys(fleet.verdicts).sort().map((k) => {
+    const v = fleet.verdicts[k];
+    const tr = el("tr", { "data-verdict": v.name || String(v.index), "data-result": v.result });
+    tr.append(el("td", {}, v.scenario), el("td", {}, String(v.cycle)), el("td", {}, v.name || `#${v.index}`),
+      el("td", { class: "verdict-" + v.result }, v.result), el("td", {}, v.text));
+    return tr;
+  });
+  body.replaceChildren(...rows);
+}
+
 function render() {
+  renderScenario();
   renderHeader();
   renderOverview();
   renderBuses();
