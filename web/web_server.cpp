@@ -108,7 +108,7 @@ struct WebServer::Impl {
     stats.*field += n;
   }
   void Accept();
-  Response Answer(const Request& req, unsigned version, bool keep_alive);
+  Response Answer(const Request& req);
   std::string Info() const {
     return std::string("{\"actions\":") + (actions_enabled ? "true" : "false") +
            ",\"token_required\":" + (token_required ? "true" : "false") +
@@ -257,7 +257,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       Action(std::move(req));
       return;
     }
-    Write(impl_.Answer(req, req.version(), req.keep_alive()));
+    Write(impl_.Answer(req));
   }
 
   Response Plain(const Request& req, http::status status, std::string body) {
@@ -332,9 +332,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
 }  // namespace
 
-Response WebServer::Impl::Answer(const Request& req, unsigned version, bool keep_alive) {
-  Response res{http::status::ok, version};
-  res.keep_alive(keep_alive);
+Response WebServer::Impl::Answer(const Request& req) {
+  Response res{http::status::ok, req.version()};
+  res.keep_alive(req.keep_alive());
   res.set(http::field::cache_control, "no-store");
   const std::string target(req.target().substr(0, req.target().find('?')));
   if (req.method() != http::verb::get && req.method() != http::verb::head) {

@@ -47,13 +47,12 @@ def active() -> Optional["Clock"]:
 
 
 class _Waiter:
-    __slots__ = ("thread", "deadline_ns", "woken", "result")
+    __slots__ = ("thread", "deadline_ns", "woken")
 
     def __init__(self, thread: threading.Thread, deadline_ns: Optional[int]) -> None:
         self.thread = thread
         self.deadline_ns = deadline_ns
         self.woken = False
-        self.result: Any = None
 
 
 class _Pending:
@@ -125,12 +124,11 @@ class Clock:
     def new_waiter(self, deadline_ns: Optional[int]) -> _Waiter:
         return _Waiter(threading.current_thread(), deadline_ns)
 
-    def wake(self, waiter: _Waiter, result: Any = None) -> None:
+    def wake(self, waiter: _Waiter) -> None:
         """Ends `waiter`'s wait (call with the lock held): its thread counts as running from now,
         so time stands still until it waits again."""
         if not waiter.woken:
             waiter.woken = True
-            waiter.result = result
             self._waiting.pop(waiter.thread, None)
             self._cv.notify_all()
 

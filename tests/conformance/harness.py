@@ -188,14 +188,6 @@ class Fleet:
         except OSError:
             return False
 
-    def cli(self, *args: str, check: bool = True) -> subprocess.CompletedProcess:
-        """Runs `canfleet --control <this fleet> ARGS`."""
-        result = subprocess.run([str(self.bin_dir / "canfleet"), "--control", self.control, *args],
-                                capture_output=True, text=True, timeout=120)
-        if check and result.returncode != 0:
-            raise AssertionError(f"canfleet {' '.join(args)} exited {result.returncode}: {result.stderr.strip()}")
-        return result
-
     def io_get(self, node: str, name: str) -> str:
         assert self.api is not None
         return self.api.node(node).io_get(name).value

@@ -2,7 +2,6 @@
 (CiA 306 §4.5.2 [DeviceInfo])."""
 from __future__ import annotations
 
-import json
 
 import pytest
 from canopen.lss import LssMaster

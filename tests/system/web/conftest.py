@@ -2,6 +2,7 @@
 its own) and a real `canfleet web` reading that domain, its actions going to the fleet's control API."""
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -36,6 +37,27 @@ def start_web(*args: str, control: str = "", folder: Path) -> Dict[str, object]:
         time.sleep(0.05)
     values = dict(line.split(" ", 1) for line in ready.read_text().splitlines())
     return {"url": values["url"], "token": values.get("token", ""), "proc": proc}
+
+
+@contextlib.contextmanager
+def up_with_web(topology: Path, folder: Path, *args: str) -> Generator[str, None, None]:
+    """`canfleet up TOPOLOGY ARGS --web 127.0.0.1:0` on private endpoints; yields the page's URL
+    (from <state>/logs/web.ready) and checks that the fleet stops cleanly at the end."""
+    up = subprocess.Popen([str(find_binaries() / "canfleet"), "up", str(topology), *args,
+                           "--control", "tcp://127.0.0.1:0", "--listen", f"unix://{folder / 'b.sock'}",
+                           "--ready-file", str(folder / "ready"), "--state-dir", str(folder / "nodes"),
+                           "--web", "127.0.0.1:0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        web_ready = folder / "nodes" / "logs" / "web.ready"
+        end = time.monotonic() + 60
+        while not web_ready.exists():
+            if up.poll() is not None or time.monotonic() > end:
+                raise RuntimeError(f"canfleet up --web did not serve (exit {up.poll()})")
+            time.sleep(0.1)
+        yield web_ready.read_text().split()[1]
+    finally:
+        up.terminate()
+        assert up.wait(timeout=60) == 0
 
 
 @pytest.fixture

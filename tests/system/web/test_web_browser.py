@@ -13,7 +13,7 @@ import pytest
 
 from browser import Browser, find_chromium
 from canfleet import Fleet
-from conftest import start_web
+from conftest import PAIR, REPO, start_web, up_with_web
 
 
 @pytest.fixture
@@ -123,54 +123,24 @@ def test_the_page_of_a_read_only_server_refuses_actions(
 
 def test_in_virtual_time_the_page_counts_simulated_seconds(browser: Browser, tmp_path: Path) -> None:
     # `canfleet up --time virtual --speed 4 --web`: a fleet in virtual time, paced for a person.
-    import subprocess
-    import time
-    from canfleet.fleet import find_binaries
-    from conftest import PAIR
-    up = subprocess.Popen([str(find_binaries() / "canfleet"), "up", str(PAIR), "--time", "virtual", "--speed", "4",
-                           "--control", "tcp://127.0.0.1:0", "--listen", f"unix://{tmp_path / 'b.sock'}",
-                           "--ready-file", str(tmp_path / "ready"), "--state-dir", str(tmp_path / "nodes"),
-                           "--web", "127.0.0.1:0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        web_ready = tmp_path / "nodes" / "logs" / "web.ready"
-        end = time.monotonic() + 60
-        while not web_ready.exists() and time.monotonic() < end:
-            time.sleep(0.1)
-        browser.open(web_ready.read_text().split()[1])
+    with up_with_web(PAIR, tmp_path, "--time", "virtual", "--speed", "4") as url:
+        browser.open(url)
         browser.wait_for("document.querySelectorAll('#overview tbody tr').length === 3")
         browser.wait_for("document.getElementById('clock').textContent.startsWith('virtual time')")
         browser.wait_for("window.canfleet.clockPairs.length >= 2")
         browser.wait_for("document.querySelector('#buses text[data-axis]').textContent.endsWith('s simulated')")
         browser.wait_for("[...document.querySelectorAll('#events li')].some(li => li.textContent.startsWith('t='))")
         browser.screenshot(shots(tmp_path) / "web-virtual.png")
-    finally:
-        up.terminate()
-        assert up.wait(timeout=60) == 0
 
 
 def test_the_scenario_panel_shows_each_expectations_verdict(browser: Browser, tmp_path: Path) -> None:
     # The heartbeat-loss example's scenario in virtual time (as fast as it goes): its expectations'
     # verdicts, from the Verdict topic, one row each with what was seen.
-    import subprocess
-    import time
-    from canfleet.fleet import find_binaries
-    from conftest import REPO
-    up = subprocess.Popen([str(find_binaries() / "canfleet"), "up",
-                           str(REPO / "topologies" / "examples" / "heartbeat-loss.textproto"), "--time", "virtual",
-                           "--control", "tcp://127.0.0.1:0", "--listen", f"unix://{tmp_path / 'b.sock'}",
-                           "--ready-file", str(tmp_path / "ready"), "--state-dir", str(tmp_path / "nodes"),
-                           "--web", "127.0.0.1:0"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        web_ready = tmp_path / "nodes" / "logs" / "web.ready"
-        end = time.monotonic() + 60
-        while not web_ready.exists() and time.monotonic() < end:
-            time.sleep(0.1)
-        browser.open(web_ready.read_text().split()[1])
+    with up_with_web(REPO / "topologies" / "examples" / "heartbeat-loss.textproto", tmp_path,
+                     "--time", "virtual") as url:
+        browser.open(url)
         browser.wait_for("document.querySelector('#verdicts tr[data-verdict=steady][data-result=pass]') !== null")
         browser.wait_for("document.querySelector('#verdicts tr[data-verdict=emcy][data-result=pass]') !== null")
         text = browser.js("document.querySelector('#verdicts tr[data-verdict=emcy]').textContent")
         assert "8130h" in text, text
         browser.screenshot(shots(tmp_path) / "web-scenario.png")
-    finally:
-        up.terminate()
-        assert up.wait(timeout=60) == 0

@@ -7,7 +7,6 @@ import http.client
 import json
 import os
 import socket
-import subprocess
 import time
 from pathlib import Path
 from typing import Dict, List, Tuple
@@ -16,7 +15,7 @@ from urllib.parse import urlparse
 import pytest
 
 from canfleet import Fleet
-from conftest import start_web
+from conftest import PAIR, start_web, up_with_web
 
 
 def host_port(url: str) -> Tuple[str, int]:
@@ -154,27 +153,12 @@ def test_more_connections_than_it_takes_are_answered_503(fleet: Fleet, webs: Lis
 
 
 def test_canfleet_up_with_web_serves_its_fleet_and_stops_it_with_the_fleet(tmp_path: Path) -> None:
-    from canfleet.fleet import find_binaries
-    from conftest import PAIR
-    ready = tmp_path / "ready"
-    up = subprocess.Popen([str(find_binaries() / "canfleet"), "up", str(PAIR), "--control", "tcp://127.0.0.1:0",
-                           "--listen", f"unix://{tmp_path / 'b.sock'}", "--ready-file", str(ready),
-                           "--state-dir", str(tmp_path / "nodes"), "--web", "127.0.0.1:0"],
-                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        web_ready = tmp_path / "nodes" / "logs" / "web.ready"
+    with up_with_web(PAIR, tmp_path) as url:
         end = time.monotonic() + 60
-        while time.monotonic() < end and not (web_ready.exists() and "state ready" in
-                                              (ready.read_text() if ready.exists() else "")):
-            time.sleep(0.1)
-        url = web_ready.read_text().split()[1]
         while time.monotonic() < end and b"quad-6" not in get(url, "/api/state")[1]:
             time.sleep(0.2)
         assert b"quad-6" in get(url, "/api/state")[1]
         status, body = post(url, {"status": {}})  # its actions reach this fleet's control API
         assert status == 200 and "python-pair" in json.dumps(body)
-    finally:
-        up.terminate()
-        assert up.wait(timeout=60) == 0
     with pytest.raises(OSError):
         get(url, "/api/info")  # gone with the fleet
