@@ -169,7 +169,7 @@ void CanopenStack::Boot() {
 void CanopenStack::ApplyStored(std::uint16_t first, std::uint16_t last) {
   if (!store_) return;
   LoadReport report = store_->ApplyStored(first, last, node_id_);
-  if (!report.Clean() && hooks_.on_storage_issue) hooks_.on_storage_issue(report.ToString());
+  if (!report.Quiet() && hooks_.on_storage_issue) hooks_.on_storage_issue(report.ToString());
 }
 
 // Without a state directory nothing can be stored: say so instead of accepting "save" silently.

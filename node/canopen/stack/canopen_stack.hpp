@@ -68,7 +68,8 @@ struct StackHooks {
   std::function<void(NmtState)> on_state_changed;
   /// Every communication error as it appears (true) and disappears (false), after the policy ran.
   std::function<void(const CommError&, bool)> on_comm_error;
-  /// Stored parameters that could not be applied (corrupt file, missing object...): one line each.
+  /// Stored parameters that could not be applied (corrupt file, missing object...), and a save all
+  /// or restore all that a kill interrupted and the store completed or discarded: one line each.
   std::function<void(const std::string&)> on_storage_issue;
   /// The port should switch to this CiA 305 table-0 index: LSS "activate bit timing" completed,
   /// or the bit-rate object (StackOptions::bit_rate_object) holds another rate at reset.

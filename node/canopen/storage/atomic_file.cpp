@@ -35,13 +35,6 @@ class Fd {
   int fd_;
 };
 
-std::error_code SyncDirectory(const std::filesystem::path& dir) {
-  Fd fd(::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (fd.get() < 0) return LastError();
-  if (::fsync(fd.get()) != 0) return LastError();
-  return fd.Close();
-}
-
 std::error_code WriteAll(int fd, std::span<const std::uint8_t> bytes) {
   while (!bytes.empty()) {
     ssize_t n = ::write(fd, bytes.data(), bytes.size());
@@ -56,10 +49,29 @@ std::error_code WriteAll(int fd, std::span<const std::uint8_t> bytes) {
 
 }  // namespace
 
+std::error_code SyncDirectory(const std::filesystem::path& dir) {
+  Fd fd(::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (fd.get() < 0) return LastError();
+  if (::fsync(fd.get()) != 0) return LastError();
+  return fd.Close();
+}
+
 std::filesystem::path TempPathFor(const std::filesystem::path& path) {
   auto tmp = path;
   tmp += ".tmp";
   return tmp;
+}
+
+std::error_code WriteFileDurably(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {
+  Fd fd(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  if (fd.get() < 0) return LastError();
+  if (auto ec = WriteAll(fd.get(), bytes)) return ec;
+  if (::fsync(fd.get()) != 0) return LastError();
+  return fd.Close();
+}
+
+std::error_code RenameFile(const std::filesystem::path& from, const std::filesystem::path& to) {
+  return ::rename(from.c_str(), to.c_str()) == 0 ? std::error_code{} : LastError();
 }
 
 std::error_code WriteFileAtomically(const std::filesystem::path& path, std::span<const std::uint8_t> bytes) {
@@ -70,14 +82,8 @@ std::error_code WriteFileAtomically(const std::filesystem::path& path, std::span
     if (ec) return ec;
   }
   const auto tmp = TempPathFor(path);
-  {
-    Fd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
-    if (fd.get() < 0) return LastError();
-    ec = WriteAll(fd.get(), bytes);
-    if (!ec && ::fsync(fd.get()) != 0) ec = LastError();
-    if (!ec) ec = fd.Close();
-  }
-  if (!ec && ::rename(tmp.c_str(), path.c_str()) != 0) ec = LastError();
+  ec = WriteFileDurably(tmp, bytes);
+  if (!ec) ec = RenameFile(tmp, path);
   if (ec) {
     ::unlink(tmp.c_str());  // best effort; a leftover is harmless (never read, truncated next time)
     return ec;
@@ -85,11 +91,12 @@ std::error_code WriteFileAtomically(const std::filesystem::path& path, std::span
   return SyncDirectory(dir);
 }
 
+std::error_code RemoveFile(const std::filesystem::path& path) {
+  return ::unlink(path.c_str()) == 0 ? std::error_code{} : LastError();
+}
+
 std::error_code RemoveFileDurably(const std::filesystem::path& path) {
-  if (::unlink(path.c_str()) != 0) {
-    if (errno == ENOENT) return {};
-    return LastError();
-  }
+  if (auto ec = RemoveFile(path)) return ec == std::errc::no_such_file_or_directory ? std::error_code{} : ec;
   return SyncDirectory(path.parent_path());
 }
 

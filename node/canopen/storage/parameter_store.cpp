@@ -1,5 +1,6 @@
 #include "node/canopen/storage/parameter_store.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 
@@ -51,16 +52,13 @@ std::optional<Bytes> RelativeValue(const SubObject& sub, const Bytes& value, std
   return EncodeLe(relative, *size);
 }
 
-std::vector<const StoreGroupInfo*> GroupsFor(std::uint8_t sub) {
+/// The one group of 1010h/1011h sub-index 2..127 (sub 1 is all of them).
+const StoreGroupInfo& SingleGroupFor(std::uint8_t sub) {
+  const StoreGroup wanted = sub == 2   ? StoreGroup::kCommunication
+                            : sub == 3 ? StoreGroup::kApplication
+                                       : StoreGroup::kManufacturer;
   const auto& groups = ParameterGroups();
-  std::vector<const StoreGroupInfo*> out;
-  for (const auto& g : groups) {
-    const bool wanted = sub == 1 || (sub == 2 && g.group == StoreGroup::kCommunication) ||
-                        (sub == 3 && g.group == StoreGroup::kApplication) ||
-                        (sub >= 4 && g.group == StoreGroup::kManufacturer);
-    if (wanted) out.push_back(&g);
-  }
-  return out;
+  return *std::find_if(groups.begin(), groups.end(), [wanted](const auto& g) { return g.group == wanted; });
 }
 
 }  // namespace
@@ -75,7 +73,8 @@ std::string StoreIssue::ToString() const {
 }
 
 std::string LoadReport::ToString() const {
-  std::string out;
+  std::string out = recovery.ToString();
+  if (!out.empty()) out += '\n';
   for (const auto& issue : issues) {
     out += issue.ToString();
     out += '\n';
@@ -96,6 +95,35 @@ ParameterStore::ParameterStore(ObjectDictionary& od, std::filesystem::path state
     : od_(od), state_dir_(std::move(state_dir)) {
   InstallHooks(kStoreIndex, kSaveSignature);
   InstallHooks(kRestoreIndex, kLoadSignature);
+  // Here, before anything can read or write a group file: every reader then sees all groups from
+  // one save, and no new transaction can stage files that an old commit record would adopt.
+  SettleInterruptedChange();
+}
+
+// Runs recovery (store_transaction.hpp) and keeps its outcome for the next ApplyStored report: the
+// library logs nothing itself. On an I/O error the flag stays set, so the next access retries
+// instead of reading a half-applied change or starting a new one on top of it.
+bool ParameterStore::SettleInterruptedChange() {
+  TransactionRecovery recovery;
+  const auto ec = RecoverStoreTransaction(state_dir_, recovery);
+  if (recovery.outcome != TransactionRecovery::Outcome::kNothing) {
+    // Only "save all" stages files, so staged files without a valid record were a save all.
+    const bool staged = std::any_of(recovery.files.begin(), recovery.files.end(),
+                                    [](const std::string& name) { return name.ends_with(kStagedSuffix); });
+    if (recovery.operation.empty() && staged) recovery.operation = "save all";
+    unreported_recovery_ = std::move(recovery);
+  }
+  settle_needed_ = static_cast<bool>(ec);
+  settle_error_ =
+      ec ? "could not complete or discard an interrupted save all / restore all: " + ec.message() : "";
+  return !ec;
+}
+
+void ParameterStore::ReportRecovery(LoadReport& report) {
+  if (settle_needed_) SettleInterruptedChange();
+  report.recovery = std::exchange(unreported_recovery_, {});
+  if (!settle_error_.empty())
+    report.issues.push_back({state_dir_ / kCommitRecordName, StoreProblem::kIoError, 0, 0, settle_error_});
 }
 
 std::filesystem::path ParameterStore::PathOf(StoreGroup group) const {
@@ -184,26 +212,69 @@ SdoAbort ParameterStore::SaveGroup(const StoreGroupInfo& group) {
   return SdoAbort::kNone;
 }
 
-SdoAbort ParameterStore::Save(std::uint8_t sub) {
-  if (sub == 0 || sub > 127) return SdoAbort::kNoSubIndex;
-  for (const auto* group : GroupsFor(sub)) {
-    if (auto rc = SaveGroup(*group); rc != SdoAbort::kNone) return rc;
+// A failed Commit may leave staged files or a commit record: settle them right away (the groups
+// are then all old or all new, and the next report says which), or, if even that fails, before
+// the next access.
+SdoAbort ParameterStore::CommitAll(StoreTransaction& change) {
+  if (auto ec = change.Commit()) {
+    last_error_ = change.FailedPath().string() + ": " + ec.message();
+    SettleInterruptedChange();
+    return SdoAbort::kHardwareError;
   }
-  last_error_.clear();
   return SdoAbort::kNone;
 }
 
-SdoAbort ParameterStore::MarkRestoreDefaults(std::uint8_t sub) {
-  if (sub == 0 || sub > 127) return SdoAbort::kNoSubIndex;
-  for (const auto* group : GroupsFor(sub)) {
-    const auto path = PathOf(group->group);
-    if (auto ec = RemoveFileDurably(path)) {
-      last_error_ = path.string() + ": " + ec.message();
-      return SdoAbort::kHardwareError;
-    }
+SdoAbort ParameterStore::SaveAll() {
+  StoreTransaction change(state_dir_, "save all");
+  for (const auto& group : ParameterGroups())
+    change.Replace(group.file_name, EncodeStoreFile(Snapshot(group)));
+  return CommitAll(change);
+}
+
+SdoAbort ParameterStore::RestoreAll() {
+  StoreTransaction change(state_dir_, "restore all");
+  for (const auto& group : ParameterGroups())
+    change.Remove(group.file_name);
+  return CommitAll(change);
+}
+
+SdoAbort ParameterStore::RemoveGroup(const StoreGroupInfo& group) {
+  const auto path = PathOf(group.group);
+  if (auto ec = RemoveFileDurably(path)) {
+    last_error_ = path.string() + ": " + ec.message();
+    return SdoAbort::kHardwareError;
   }
-  last_error_.clear();
   return SdoAbort::kNone;
+}
+
+SdoAbort ParameterStore::Save(std::uint8_t sub) {
+  return Change(sub, ChangeKind::kSave);
+}
+
+SdoAbort ParameterStore::MarkRestoreDefaults(std::uint8_t sub) {
+  return Change(sub, ChangeKind::kRestore);
+}
+
+// What 1010h and 1011h share: the sub-index check, settling a transaction an I/O error left
+// behind before touching the files again, and LastError(). One group is one file, which
+// WriteFileAtomically/RemoveFileDurably change all-or-nothing already; all groups take a
+// transaction.
+SdoAbort ParameterStore::Change(std::uint8_t sub, ChangeKind kind) {
+  if (sub == 0 || sub > 127) return SdoAbort::kNoSubIndex;
+  if (settle_needed_ && !SettleInterruptedChange()) {
+    last_error_ = settle_error_;
+    return SdoAbort::kHardwareError;
+  }
+  const bool save = kind == ChangeKind::kSave;
+  SdoAbort rc = SdoAbort::kNone;
+  if (sub == 1) {
+    rc = save ? SaveAll() : RestoreAll();
+  } else {
+    const StoreGroupInfo& group = SingleGroupFor(sub);
+    rc = save ? SaveGroup(group) : RemoveGroup(group);
+  }
+  if (rc == SdoAbort::kNone) last_error_.clear();
+  return rc;
 }
 
 std::optional<StoreImage> ParameterStore::LoadImage(StoreGroup group, LoadReport& report) const {
@@ -274,6 +345,7 @@ void ParameterStore::ApplyEntry(const StoreGroupInfo& group, const std::filesyst
 LoadReport ParameterStore::ApplyStored(std::uint16_t first, std::uint16_t last, std::uint8_t node_id) {
   node_id_ = node_id;
   LoadReport report;
+  ReportRecovery(report);
   for (const auto& group : ParameterGroups()) {
     if (group.last < first || group.first > last) continue;
     auto image = LoadImage(group.group, report);

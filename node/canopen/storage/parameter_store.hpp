@@ -5,12 +5,12 @@
 ///
 /// Groups (1010h/1011h sub-index → object range → file in the state directory):
 ///
-/// | sub   | group          | objects        | file            |
-/// |-------|----------------|----------------|-----------------|
-/// | 1     | all            | the three below| all three files |
-/// | 2     | communication  | 1000h–1FFFh    | params-comm.bin |
-/// | 3     | application    | 6000h–9FFFh    | params-app.bin  |
-/// | 4..7F | manufacturer   | 2000h–5FFFh    | params-mfr.bin  |
+/// | sub   | group          | objects         | file                                |
+/// |-------|----------------|-----------------|-------------------------------------|
+/// | 1     | all            | the three below | all three files, in one transaction |
+/// | 2     | communication  | 1000h–1FFFh     | params-comm.bin                     |
+/// | 3     | application    | 6000h–9FFFh     | params-app.bin                      |
+/// | 4..7F | manufacturer   | 2000h–5FFFh     | params-mfr.bin                      |
 ///
 /// Sub-indexes 2 and 3 and their ranges are CiA 301's; CiA 301 leaves 4..7Fh to the manufacturer,
 /// and the five device manuals use exactly sub 4 for "manufacturer" (2000h–5FFFh here). Objects
@@ -28,8 +28,16 @@
 /// which then finds no stored values and keeps the defaults (the manuals: restored defaults take
 /// effect only after a reset).
 ///
+/// Crash safety: after a kill or a power cut at any moment, every group comes from the same save
+/// (the old one or the new one); a restore all likewise removes all three files or none. A single
+/// group (sub 2..7Fh) is one file, replaced atomically (atomic_file.hpp). Sub 1 changes the three files in
+/// one transaction (store_transaction.hpp: staged "<file>.new" files, then the commit record
+/// "store-commit.bin", then the renames); the constructor completes or discards a transaction
+/// that a kill interrupted before anything reads the directory, and the next ApplyStored report
+/// says which it did.
+///
 /// Storage is synchronous: the node is single-threaded and a file is a few KB, so a 1010h write
-/// returns once the file is durable (see atomic_file.hpp for the crash-safe write sequence).
+/// returns once the files are durable.
 
 #include <cstdint>
 #include <filesystem>
@@ -41,6 +49,7 @@
 
 #include "node/canopen/od/object_dictionary.hpp"
 #include "node/canopen/storage/store_file.hpp"
+#include "node/canopen/storage/store_transaction.hpp"
 
 namespace canfleet::canopen {
 
@@ -68,9 +77,16 @@ struct LoadReport {
   std::vector<std::filesystem::path> files_applied;  ///< files whose entries were applied
   std::size_t entries_applied = 0;
   std::vector<StoreIssue> issues;
+  /// A save all / restore all that a kill interrupted and the store then completed or discarded
+  /// (ParameterStore's constructor, or after a failed save). Carried once, by the next
+  /// ApplyStored report; kNothing usually.
+  TransactionRecovery recovery;
 
+  /// No issue (a recovery is not one: the groups are consistent again).
   bool Clean() const { return issues.empty(); }
-  /// One line per issue, for the node's log.
+  /// Nothing worth a log line: clean and no recovery.
+  bool Quiet() const { return Clean() && recovery.outcome == TransactionRecovery::Outcome::kNothing; }
+  /// One line for the recovery, if any, and one per issue, for the node's log.
   std::string ToString() const;
 };
 
@@ -87,7 +103,9 @@ const std::vector<StoreGroupInfo>& ParameterGroups();
 class ParameterStore {
  public:
   /// Installs the 1010h/1011h hooks on every existing sub-index ≥ 1 of those objects (call
-  /// AddStorageObjects first if the device has none). Reads nothing yet.
+  /// AddStorageObjects first if the device has none), and settles a save all / restore all that a
+  /// kill interrupted (store_transaction.hpp), so that every later read sees all groups from the
+  /// same save; the next ApplyStored reports what that did. Applies no stored value yet.
   /// @param od must outlive the store; the hooks capture `this`, so the store must not move.
   /// @param state_dir the node's own directory; created on the first save.
   ParameterStore(ObjectDictionary& od, std::filesystem::path state_dir);
@@ -102,13 +120,13 @@ class ParameterStore {
   LoadReport ApplyStored(std::uint16_t first, std::uint16_t last, std::uint8_t node_id);
 
   /// Stores the current values of group `sub` (1 all, 2 comm, 3 application, 4..127 manufacturer).
-  /// kNone on success, kNoSubIndex for sub 0 or > 127, kHardwareError (06060000h) if the file
-  /// cannot be written (LastError() says why). Sub 1 writes the three files one after the other:
-  /// each file is replaced atomically, so a failure part-way leaves the earlier groups saved and
-  /// the later ones as they were.
+  /// kNone on success, kNoSubIndex for sub 0 or > 127, kHardwareError (06060000h) if the files
+  /// cannot be written (LastError() says why). Sub 1 replaces the three files as one transaction:
+  /// after a kill at any moment, or a failure part-way, all three groups come from this save or
+  /// all from the previous one, never a mix. kNone means the new files are durable.
   SdoAbort Save(std::uint8_t sub);
   /// Discards the stored values of group `sub` so that the defaults apply after the next reset.
-  /// Same return codes as Save.
+  /// Same return codes as Save; sub 1 removes the three files as one transaction, like Save(1).
   SdoAbort MarkRestoreDefaults(std::uint8_t sub);
 
   /// CiA 305 store configuration: persists the LSS node-ID and bit timing index in `lss.bin`.
@@ -133,7 +151,15 @@ class ParameterStore {
   void ApplyEntry(const StoreGroupInfo& group, const std::filesystem::path& file, const StoreEntry& entry,
                   std::uint8_t node_id, LoadReport& report);
   std::optional<StoreImage> LoadImage(StoreGroup group, LoadReport& report) const;
+  enum class ChangeKind : std::uint8_t { kSave, kRestore };
+  SdoAbort Change(std::uint8_t sub, ChangeKind kind);
   SdoAbort SaveGroup(const StoreGroupInfo& group);
+  SdoAbort RemoveGroup(const StoreGroupInfo& group);
+  SdoAbort SaveAll();
+  SdoAbort RestoreAll();
+  SdoAbort CommitAll(StoreTransaction& change);
+  bool SettleInterruptedChange();
+  void ReportRecovery(LoadReport& report);
   void InstallHooks(std::uint16_t index, std::uint32_t signature);
   std::uint32_t VendorId() const;
   std::uint32_t ProductCode() const;
@@ -143,6 +169,13 @@ class ParameterStore {
   std::set<std::uint16_t> excluded_;
   std::uint8_t node_id_ = 0;
   std::string last_error_;
+  /// A transaction may be left unsettled (an I/O error during Commit or recovery): settle it
+  /// before the next read or change of the directory.
+  bool settle_needed_ = true;
+  /// What the last settling did, for the next ApplyStored report.
+  TransactionRecovery unreported_recovery_;
+  /// Why the last settling failed ("" if it did not).
+  std::string settle_error_;
 };
 
 /// Creates 1010h "Store parameters" and 1011h "Restore default parameters" as ARRAYs: sub 0 = 4

@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 
 #include "node/canopen/stack/standard_objects.hpp"
+#include "node/canopen/storage/atomic_file.hpp"
 #include "tests/support/bus_probe.hpp"
 
 namespace canfleet::canopen {
@@ -240,6 +242,65 @@ TEST_F(StoredStackTest, SavedParametersSurviveARestart) {
   stack.Start();
   EXPECT_EQ(od.GetUnsigned(0x1017, 0), 250u);
   EXPECT_EQ(od.GetUnsigned(0x2000, 0), 42u);
+}
+
+// A save all killed part-way (storage/store_transaction.hpp) is settled when the stack starts,
+// before it applies anything, and the storage hook says so: with its commit record written the
+// save is completed, without it the staged files are discarded.
+TEST_F(StoredStackTest, AnInterruptedSaveAllIsSettledAndReportedAtStart) {
+  auto run = [this](const std::function<void(CanopenStack&, ObjectDictionary&)>& body,
+                    std::vector<std::string>* logged = nullptr) {
+    SimulatedScheduler scheduler;
+    LoopbackBus bus;
+    auto& port = bus.Attach("node");
+    ObjectDictionary od;
+    BuildOd(od);
+    StackHooks hooks;
+    if (logged) hooks.on_storage_issue = [logged](const std::string& text) { logged->push_back(text); };
+    CanopenStack stack(od, port, scheduler, Options(), std::move(hooks));
+    stack.Start();
+    body(stack, od);
+  };
+  // A save all of 1017h = 250 and 2000h = 42, turned back into the state a kill just before its
+  // renames leaves: every group staged as "<file>.new", the files themselves not there yet.
+  auto interrupted_save_all = [&](bool committed) {
+    std::filesystem::remove_all(dir);
+    run([](CanopenStack& stack, ObjectDictionary& od) {
+      od.Write(0x1017, 0, EncodeLe<std::uint16_t>(250), Origin::kDevice);
+      od.Write(0x2000, 0, EncodeLe<std::uint16_t>(42), Origin::kDevice);
+      ASSERT_EQ(stack.store()->Save(1), SdoAbort::kNone);
+    });
+    CommitRecord record{"save all", {}};
+    for (const auto& group : ParameterGroups()) {
+      std::filesystem::rename(dir / group.file_name, StagedPathFor(dir / group.file_name));
+      record.actions.push_back({FileAction::kReplace, group.file_name});
+    }
+    if (committed) {
+      ASSERT_FALSE(WriteFileAtomically(dir / kCommitRecordName, EncodeCommitRecord(record)));
+    }
+  };
+
+  interrupted_save_all(true);
+  std::vector<std::string> logged;
+  run(
+      [](CanopenStack&, ObjectDictionary& od) {
+        EXPECT_EQ(od.GetUnsigned(0x1017, 0), 250u);
+        EXPECT_EQ(od.GetUnsigned(0x2000, 0), 42u);
+      },
+      &logged);
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_NE(logged[0].find("completed an interrupted save all"), std::string::npos) << logged[0];
+
+  interrupted_save_all(false);
+  logged.clear();
+  run(
+      [](CanopenStack&, ObjectDictionary& od) {
+        EXPECT_EQ(od.GetUnsigned(0x1017, 0), 0u);
+        EXPECT_EQ(od.GetUnsigned(0x2000, 0), 7u);
+      },
+      &logged);
+  ASSERT_EQ(logged.size(), 1u);
+  EXPECT_NE(logged[0].find("discarded an unfinished save all"), std::string::npos) << logged[0];
 }
 
 // An error frame (what a port at another bit rate than its bus receives instead of traffic,
