@@ -1,6 +1,7 @@
 // Fuzzes the stored-parameter loader: arbitrary bytes become a store file in a state directory,
 // then the node loads it like at power-on (ParameterStore::ApplyStored, LoadLssConfig). Any input
-// must give a report, never a crash, a hang or an out-of-bounds read.
+// must give a report, never a crash, a hang or an out-of-bounds read. The same bytes also go to the
+// parser of the save-all commit record (store-commit.bin).
 //
 // Input: byte 0 selects how the rest is used, bytes 1.. are the file.
 //   bits 0–1  which file: 0 params-comm.bin, 1 params-mfr.bin, 2 params-app.bin, 3 lss.bin
@@ -130,6 +131,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!again.image || again.image->entries != decoded.image->entries ||
         !(again.image->lss == decoded.image->lss))
       std::abort();
+  }
+  // The save-all commit record's parser (store_transaction.hpp) likewise; it decides what recovery
+  // renames and removes, so it must also never accept a name outside the state directory.
+  if (auto record = DecodeCommitRecord(file)) {
+    for (const auto& action : record->actions) {
+      if (action.file_name.find('/') != std::string::npos || action.file_name == "..") std::abort();
+    }
+    if (DecodeCommitRecord(EncodeCommitRecord(*record)) != record) std::abort();
   }
 
   // The whole load path through the file system.
