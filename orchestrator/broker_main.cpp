@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bus/wire/auth_token.hpp"
 #include "bus/wire/endpoint.hpp"
 #include "orchestrator/host/broker_host.hpp"
 #include "telemetry/cli_options.hpp"
@@ -85,7 +86,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> bus_specs;
   std::vector<std::string> listens;
   std::string log_level = "info";
-  std::string ready_file;
+  std::string ready_file, token_file;
+  app.add_option("--token-file", token_file,
+                 "File holding the fleet's token, required of every client when listening beyond loopback "
+                 "(default: CANFLEET_TOKEN_FILE, else CANFLEET_TOKEN)");
   app.add_option("--bus", bus_specs,
                  "A bus: NAME[:BITRATE][:unpaced], e.g. can0, can0:250k, can1:1M:unpaced (repeatable; "
                  "default can0:500k)");
@@ -149,6 +153,7 @@ int main(int argc, char** argv) {
   try {
     for (const auto& spec : bus_specs)
       host.AddBus(ParseBus(spec));
+    host.server().SetToken(canfleet::wire::ResolveToken(token_file).value_or(""));
     for (const auto& text : listens)
       host.Listen(canfleet::wire::Endpoint::Parse(text));
     if (telemetry_enabled)

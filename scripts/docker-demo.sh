@@ -7,8 +7,9 @@
 # (q or Ctrl-C). Then the fleet is removed (`compose down -v`).
 #   scripts/docker-demo.sh [--keep]     --keep: leave the fleet running after canfleet-top
 #
-# The control API is published on 127.0.0.1:29700 (CANFLEET_CONTROL_PORT): `build/bin/canfleet
-# status`, or `scripts/docker-fleet.sh cli status` without a host build. In another terminal:
+# The control API is published on 127.0.0.1:29700 (CANFLEET_CONTROL_PORT) and needs the fleet's
+# token (docs/security.md): `scripts/docker-fleet.sh cli status` sends it, or by hand
+# `CANFLEET_TOKEN_FILE=build-docker/secrets/canfleet-token build/bin/canfleet status`. In another terminal:
 #   scripts/docker-fleet.sh compose stop quad-5      # quad-6, dio-20: EMCY 8130h, fault state
 #   scripts/docker-fleet.sh compose start quad-5     # back, configured again; then:
 #   scripts/docker-fleet.sh cli nmt start

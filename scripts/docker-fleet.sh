@@ -20,6 +20,9 @@
 # CANFLEET_CAN1_PORT (29537), CANFLEET_DDS_DOMAIN (0): host ports are published on 127.0.0.1 only.
 # CANFLEET_CLI: the canfleet binary to use on the host (default build/bin/canfleet when built,
 # else, or with CANFLEET_CLI=container, `canfleet` run inside the orchestrator's container).
+# CANFLEET_TOKEN_HOST_FILE: the fleet's token (default build-docker/secrets/canfleet-token, made
+# here with a random token when missing); the containers get it as the Docker secret canfleet_token
+# and the host's CLI sends it (the control API listens beyond loopback inside its container).
 # Exit codes: 0 done, 1 failed or timed out, 2 usage, 3 no compose tool or no Docker engine.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -49,12 +52,30 @@ compose_tool() {
 compose_tool
 dc() { "${compose[@]}" -f "$compose_file" -p "$CANFLEET_PROJECT" "$@"; }
 
+# The fleet's token file: made once, random, readable only through a folder its owner alone may
+# enter (the file itself must be readable by the containers' user, which is not the host's).
+export CANFLEET_TOKEN_HOST_FILE="${CANFLEET_TOKEN_HOST_FILE:-$repo/build-docker/secrets/canfleet-token}"
+ensure_token() {
+  [ -s "$CANFLEET_TOKEN_HOST_FILE" ] && return 0
+  local dir tmp
+  dir=$(dirname "$CANFLEET_TOKEN_HOST_FILE")
+  mkdir -p "$dir"
+  chmod 700 "$dir"
+  tmp=$(mktemp "$dir/.token.XXXXXX")
+  od -An -N16 -tx1 /dev/urandom | tr -d ' \n' >"$tmp"
+  echo >>"$tmp"
+  chmod 644 "$tmp"
+  mv "$tmp" "$CANFLEET_TOKEN_HOST_FILE"
+  say "made the fleet's token: $CANFLEET_TOKEN_HOST_FILE"
+}
+ensure_token
+
 # The canfleet CLI talking to the fleet's control API.
 cli() {
   local bin="${CANFLEET_CLI:-}"
   if [ -z "$bin" ] && [ -x "$repo/build/bin/canfleet" ]; then bin="$repo/build/bin/canfleet"; fi
   if [ -n "$bin" ] && [ "$bin" != container ]; then
-    "$bin" --control "tcp://127.0.0.1:$CANFLEET_CONTROL_PORT" "$@"
+    CANFLEET_TOKEN_FILE="$CANFLEET_TOKEN_HOST_FILE" "$bin" --control "tcp://127.0.0.1:$CANFLEET_CONTROL_PORT" "$@"
   else
     dc exec -T orchestrator canfleet --control tcp://127.0.0.1:29700 "$@"
   fi

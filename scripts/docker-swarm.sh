@@ -15,6 +15,11 @@
 #                                                 (e.g. `cli can0 status`, `cli can0 nmt start`)
 #   scripts/docker-swarm.sh top [ARGS...]         canfleet-top in a container on the overlay network,
 #   scripts/docker-swarm.sh watch [ARGS...]       canfleet-watch likewise (DDS: every bus, every node)
+#   scripts/docker-swarm.sh web [--port P] [ARGS...]
+#                                  canfleet web likewise, published on 127.0.0.1:P of this host
+#                                  (default 8080): every bus's nodes, plots and timeline from DDS;
+#                                  read-only (one web per fleet, one control API per bus: use
+#                                  `canfleet web --control` of a bus for actions)
 #   scripts/docker-swarm.sh ps                    the stack's tasks
 #   scripts/docker-swarm.sh render [SHARDS] [--out DIR]   only write the stack file and topologies
 #   scripts/docker-swarm.sh down                  remove the stack and its network; check that no
@@ -30,6 +35,9 @@
 # control ports (default build/bin/canfleet when built; else `canfleet` inside the bus's
 # orchestrator container when it runs here, else in a container on the overlay network);
 # CANFLEET_SWARM_HOST: the address of the orchestrators' host for CANFLEET_CLI (127.0.0.1).
+# CANFLEET_TOKEN_HOST_FILE: the fleet's token (default build-docker/secrets/canfleet-token, made
+# with a random token when missing, shared with scripts/docker-fleet.sh): deployed as a Docker
+# secret to every orchestrator and node, and sent by the CLI used here.
 # Exit codes: 0 done, 1 failed or timed out, 2 usage, 3 no Docker engine or no swarm manager.
 set -euo pipefail
 repo="$(cd "$(dirname "$0")/.." && pwd)"
@@ -39,10 +47,27 @@ image="${CANFLEET_IMAGE:-canfleet:dev}"
 domain="${CANFLEET_DDS_DOMAIN:-0}"
 subnet="${CANFLEET_SWARM_SUBNET:-10.213.0.0/16}"
 monitors="${CANFLEET_SWARM_MONITORS:-4}"
+MONITOR_DOCKER_ARGS=()
 net="${stack}_fleet"
 
 say() { echo "docker-swarm: $*"; }
 die() { echo "docker-swarm: ERROR: $1" >&2; exit "${2:-1}"; }
+
+# The fleet's token file (as scripts/docker-fleet.sh makes it).
+export CANFLEET_TOKEN_HOST_FILE="${CANFLEET_TOKEN_HOST_FILE:-$repo/build-docker/secrets/canfleet-token}"
+ensure_token() {
+  [ -s "$CANFLEET_TOKEN_HOST_FILE" ] && return 0
+  local dir tmp
+  dir=$(dirname "$CANFLEET_TOKEN_HOST_FILE")
+  mkdir -p "$dir"
+  chmod 700 "$dir"
+  tmp=$(mktemp "$dir/.token.XXXXXX")
+  od -An -N16 -tx1 /dev/urandom | tr -d ' \n' >"$tmp"
+  echo >>"$tmp"
+  chmod 644 "$tmp"
+  mv "$tmp" "$CANFLEET_TOKEN_HOST_FILE"
+  say "made the fleet's token: $CANFLEET_TOKEN_HOST_FILE"
+}
 
 need_manager() {
   command -v docker >/dev/null || die "no 'docker' command" 3
@@ -82,14 +107,16 @@ cli() {
   shift
   if [ -z "$bin" ] && [ -x "$repo/build/bin/canfleet" ]; then bin="$repo/build/bin/canfleet"; fi
   if [ -n "$bin" ] && [ "$bin" != container ]; then
-    "$bin" --control "tcp://${CANFLEET_SWARM_HOST:-127.0.0.1}:$(label "$bus-orchestrator" canfleet.control-port)" "$@"
+    CANFLEET_TOKEN_FILE="$CANFLEET_TOKEN_HOST_FILE" \
+      "$bin" --control "tcp://${CANFLEET_SWARM_HOST:-127.0.0.1}:$(label "$bus-orchestrator" canfleet.control-port)" "$@"
     return
   fi
   c=$(docker ps -q --filter "label=com.docker.swarm.service.name=$(service "$bus-orchestrator")" | head -1)
   if [ -n "$c" ]; then
     docker exec "$c" canfleet --control tcp://127.0.0.1:29700 "$@"
   else
-    docker run --rm --network "$net" "$image" canfleet --control "tcp://$bus-orchestrator:29700" "$@"
+    docker run --rm --network "$net" -v "$CANFLEET_TOKEN_HOST_FILE:/run/secrets/canfleet_token:ro" \
+      -e CANFLEET_TOKEN_FILE=/run/secrets/canfleet_token "$image" canfleet --control "tcp://$bus-orchestrator:29700" "$@"
   fi
 }
 
@@ -143,10 +170,11 @@ wait_operational() {
 }
 
 render() { # SHARDS OUT
+  ensure_token
   python3 "$repo/docker/swarm/render.py" "$1" --out "$2" --stack "$stack" --network "$net" --subnet "$subnet" \
     --monitors "$monitors" --domain "$domain" --image "$image" --log-level "${CANFLEET_LOG_LEVEL:-info}" \
     --broker-base "${CANFLEET_SWARM_BROKER_BASE:-29600}" --control-base "${CANFLEET_SWARM_CONTROL_BASE:-29700}" \
-    --socketcand-base "${CANFLEET_SWARM_SOCKETCAND_BASE:-29800}"
+    --socketcand-base "${CANFLEET_SWARM_SOCKETCAND_BASE:-29800}" --token-file "$CANFLEET_TOKEN_HOST_FILE"
 }
 
 # The overlay network: attachable (monitors and CLI containers join it), with tasks' addresses from
@@ -171,6 +199,7 @@ make_network() { # OUT
 monitor() { # PROGRAM ARGS...
   local program=$1 slot i=0 err rc taken tty=()
   shift
+  # MONITOR_DOCKER_ARGS: more `docker run` options (the web view's published port).
   docker network inspect "$net" >/dev/null 2>&1 || die "no network $net: is stack $stack deployed?"
   [ -t 0 ] && [ -t 1 ] && tty=(-it)
   # The addresses in use on the network, every host's (the verbose view comes from the network's
@@ -182,7 +211,7 @@ monitor() { # PROGRAM ARGS...
     case "$taken" in *" $slot "*) continue ;; esac
     # The image's CANFLEET_DDS_CONFIG is emptied so that CYCLONEDDS_URI (the configuration itself) is used.
     docker run --rm "${tty[@]}" --name "$stack-monitor-$i" --network "$net" --ip "$slot" \
-      --label "canfleet.stack=$stack" -e CANFLEET_DDS_CONFIG= \
+      --label "canfleet.stack=$stack" -e CANFLEET_DDS_CONFIG= "${MONITOR_DOCKER_ARGS[@]}" \
       -e "CYCLONEDDS_URI=$(net_label canfleet.dds-uri)" -e "CANFLEET_DDS_DOMAIN=$(net_label canfleet.dds-domain)" \
       "$image" "$program" "$@" 2>"$err" && rc=0 || rc=$?
     if [ "$rc" = 125 ] && grep -qiE 'in use|already|Conflict|attaching to network failed' "$err"; then
@@ -298,6 +327,18 @@ case "$cmd" in
   cli) cli "$@" ;;
   top) monitor canfleet-top "$@" ;;
   watch) monitor canfleet-watch "$@" ;;
+  web)
+    port=8080
+    if [ "${1:-}" = --port ]; then
+      port="${2:?--port needs a port}"
+      shift 2
+    fi
+    # Inside its container it listens on every address so that the published port reaches it; the
+    # host publishes it on loopback only, and it takes no actions (no token to hand out here).
+    MONITOR_DOCKER_ARGS=(-p "127.0.0.1:$port:8080")
+    say "canfleet web on http://127.0.0.1:$port/ (read-only; Ctrl-C stops it)"
+    monitor canfleet web --listen 0.0.0.0:8080 --read-only "$@"
+    ;;
   ps) docker stack ps "$stack" "$@" ;;
   render)
     shards="$repo/topologies/swarm.shards"

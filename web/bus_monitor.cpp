@@ -12,6 +12,7 @@ namespace canfleet::web {
 
 struct BusMonitor::Impl {
   std::string endpoint;
+  std::string token;
   FrameHandler on_frame;
   asio::io_context io;
   asio::executor_work_guard<asio::io_context::executor_type> work{io.get_executor()};
@@ -19,7 +20,9 @@ struct BusMonitor::Impl {
   std::thread thread;
 };
 
-BusMonitor::BusMonitor(std::string endpoint, FrameHandler on_frame) : impl_(std::make_unique<Impl>()) {
+BusMonitor::BusMonitor(std::string endpoint, std::string token, FrameHandler on_frame)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->token = std::move(token);
   impl_->endpoint = std::move(endpoint);
   impl_->on_frame = std::move(on_frame);
   impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
@@ -41,6 +44,7 @@ void BusMonitor::Watch(const std::string& bus) {
     options.bus = bus;
     options.node_name = "canfleet-web";
     options.monitor = true;
+    options.token = impl->token;
     auto port = std::make_unique<BrokerClientPort>(impl->io, options);
     port->OnReceive(
         [impl, bus](const CanFrame& frame, BusTime time) { impl->on_frame(bus, frame, time.count()); });

@@ -19,7 +19,8 @@ class BusMonitor {
       std::function<void(const std::string& bus, const CanFrame& frame, std::int64_t time_ns)>;
   /// Watches buses of the broker at `endpoint` (tcp://HOST:PORT, unix:///path); `on_frame` runs
   /// on the monitor's thread.
-  BusMonitor(std::string endpoint, FrameHandler on_frame);
+  /// `token`: the fleet's, for a broker beyond loopback (empty: none).
+  BusMonitor(std::string endpoint, std::string token, FrameHandler on_frame);
   ~BusMonitor();
   BusMonitor(const BusMonitor&) = delete;
   BusMonitor& operator=(const BusMonitor&) = delete;

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <thread>
 
+#include "bus/wire/auth_token.hpp"
 #include "telemetry/cli_options.hpp"
 #include "telemetry/fleet_reader.hpp"
 #include "web/bus_monitor.hpp"
@@ -66,8 +67,9 @@ void AddWebOptions(CLI::App& app, WebOptions& options) {
   app.add_option("--static", options.static_dir,
                  "Folder of the page's files (default: the repository's web/static)");
   app.add_flag("--read-only", options.read_only, "No actions from the page (faults, I/O, NMT, SDO)");
-  app.add_option("--token", options.token,
-                 "Token the page's actions must carry (default: made up when needed)");
+  app.add_option("--token-file", options.token_file,
+                 "File holding the token the page's actions must carry (default: CANFLEET_TOKEN_FILE, else "
+                 "CANFLEET_TOKEN, else one made up and printed when actions are on beyond loopback)");
   app.add_option("--retention", options.retention_s, "Seconds of plots and timeline kept (default 600)")
       ->check(CLI::Range(10, 86400));
   app.add_option("--update-ms", options.update_ms, "Milliseconds between updates to the page (default 200)")
@@ -95,9 +97,15 @@ int RunWeb(const WebOptions& options) {
   }
   server_options.control = options.control;
   server_options.read_only = options.read_only;
-  server_options.token = options.token;
+  try {
+    server_options.token = wire::ResolveToken(options.token_file).value_or("");
+  } catch (const std::runtime_error& e) {
+    std::cerr << "canfleet web: " << e.what() << '\n';
+    return 2;
+  }
   server_options.update_period = std::chrono::milliseconds(options.update_ms);
 
+  const std::string fleet_token = server_options.token;
   WebStateOptions state_options;
   state_options.retention = std::chrono::seconds(options.retention_s);
   WebState state(std::chrono::system_clock::now(), state_options);
@@ -137,10 +145,10 @@ int RunWeb(const WebOptions& options) {
   }
   std::unique_ptr<BusMonitor> monitor;
   if (!options.broker.empty())
-    monitor = std::make_unique<BusMonitor>(
-        options.broker, [&state](const std::string& bus, const CanFrame& frame, std::int64_t time_ns) {
-          state.Frame(bus, frame, time_ns);
-        });
+    monitor =
+        std::make_unique<BusMonitor>(options.broker, fleet_token,
+                                     [&state](const std::string& bus, const CanFrame& frame,
+                                              std::int64_t time_ns) { state.Frame(bus, frame, time_ns); });
   std::thread serving([&] { server->Run(); });
   auto last_trim = std::chrono::steady_clock::now();
   while (!g_stop) {

@@ -19,7 +19,7 @@ struct WebOptions {
   std::string control;                    ///< control endpoint for actions; empty: read-only
   std::string broker;                     ///< broker endpoint for CANopen-Diag statistics; empty: none
   bool read_only = false;
-  std::string token;
+  std::string token_file;  ///< --token-file; else CANFLEET_TOKEN_FILE / CANFLEET_TOKEN
   int retention_s = 600;
   int update_ms = 200;
   std::filesystem::path ready_file;  ///< written once serving: "url <url>" and "token <token>"

@@ -21,6 +21,7 @@
 #include <set>
 #include <sstream>
 
+#include "bus/wire/auth_token.hpp"
 #include "tools/telemetry/event_format.hpp"
 #include "web/action_forwarder.hpp"
 
@@ -38,17 +39,6 @@ bool IsLoopback(const std::string& address) {
   boost::system::error_code ec;
   const auto a = net::ip::make_address(address, ec);
   return !ec && a.is_loopback();
-}
-
-std::string MakeToken() {
-  std::random_device random;
-  std::ostringstream out;
-  for (int i = 0; i < 4; ++i) {
-    char buf[9];
-    std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(random()));
-    out << buf;
-  }
-  return out.str();
 }
 
 namespace {
@@ -276,7 +266,14 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
                                                           : "read-only: actions are off (--read-only)")));
       return;
     }
-    if (impl_.token_required && req[http::field::authorization] != "Bearer " + impl_.options.token) {
+    const auto header = req[http::field::authorization];
+    const std::string_view authorization(header.data(), header.size());
+    constexpr std::string_view kBearer = "Bearer ";
+    const bool token_ok = authorization.substr(0, kBearer.size()) == kBearer &&
+                          wire::TokensEqual(impl_.options.token, authorization.substr(kBearer.size()));
+    if (impl_.token_required && !token_ok) {
+      spdlog::warn("canfleet web: refused an action from {}: {}", Peer(),
+                   authorization.empty() ? "no token" : "wrong token");
       Write(Plain(
           req, http::status::forbidden,
           ErrorJson("actions need the token canfleet web printed at start (Authorization: Bearer ...)")));
@@ -321,6 +318,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     beast::error_code ignored;
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
     stream_.close();
+  }
+
+  std::string Peer() {
+    boost::system::error_code ec;
+    const auto remote = stream_.socket().remote_endpoint(ec);
+    return ec ? std::string("?") : remote.address().to_string() + ":" + std::to_string(remote.port());
   }
 
   beast::tcp_stream stream_;
@@ -427,7 +430,7 @@ WebServer::WebServer(WebState& state, WebServerOptions options)
                              std::to_string(i.options.port) + ": " + ec.message());
   i.actions_enabled = !i.options.read_only && !i.options.control.empty();
   i.token_required = i.actions_enabled && (!i.options.token.empty() || !IsLoopback(i.options.address));
-  if (i.token_required && i.options.token.empty()) i.options.token = MakeToken();
+  if (i.token_required && i.options.token.empty()) i.options.token = wire::GenerateToken();
   i.Accept();
 }
 

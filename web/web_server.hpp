@@ -43,8 +43,6 @@ struct WebServerOptions {
 
 /// Whether `address` is a loopback address (127.0.0.0/8, ::1).
 bool IsLoopback(const std::string& address);
-/// A random token (128 bits, hex) for actions.
-std::string MakeToken();
 
 class WebServer {
  public:

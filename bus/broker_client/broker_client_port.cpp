@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "bus/physics/wire_model.hpp"
+#include "bus/wire/auth_token.hpp"
 #include "bus/wire/endpoint.hpp"
 #include "bus/wire/message_writer.hpp"
 #include "bus/wire/socket_io.hpp"
@@ -158,6 +159,10 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
       socket_.set_option(asio::ip::tcp::no_delay(true), ignored);  // a batch is complete when written
     }
     phase_ = Phase::kHandshake;
+    if (endpoint_.kind == wire::Endpoint::Kind::kTcp && !options_.token.empty()) {
+      const std::string preamble = wire::EncodeAuthPreamble(options_.token);
+      filling_.AddEncoded(reinterpret_cast<const std::uint8_t*>(preamble.data()), preamble.size());
+    }
     wire::Hello hello = wire::MakeHello(options_.bus, options_.node_name, options_.node_id,
                                         options_.monitor ? wire::ROLE_MONITOR : wire::ROLE_NODE);
     hello.set_tx_confirmations(options_.tx_confirmations);

@@ -23,6 +23,9 @@ struct BrokerClientOptions {
   std::string bus = "can0";
   std::string node_name;      ///< for the broker's logs and statistics
   std::uint32_t node_id = 0;  ///< CANopen node-ID, 0 when none (a tool)
+  /// The fleet's token (bus/wire/auth_token.hpp), sent first on a TCP connection: a broker
+  /// listening beyond loopback lets in only clients that send it. Empty: none sent.
+  std::string token{};
   /// Bus monitoring (a capture tool): receives every frame and error frame, never transmits or
   /// acknowledges. Send always returns false.
   bool monitor = false;

@@ -300,9 +300,19 @@ def render(args):
     # Configs are immutable in swarm: name them by content, so deploying a changed shard file again
     # creates new ones (the stack's old ones go with `docker stack rm`, or `docker config prune`).
     configs = {"dds": {"name": f"{args.stack}_dds-{digest('cyclonedds-swarm.xml')}", "file": "./cyclonedds-swarm.xml"}}
+    # The fleet's token: the control APIs and brokers listen on every address, so every client
+    # must send it (bus/wire/auth_token.hpp). A Docker secret made from the host's token file at
+    # deploy time (in swarm's encrypted store, never in an image layer or on a command line),
+    # named by content like the configs (secrets are immutable too).
+    with open(args.token_file, "rb") as f:
+        token_digest = hashlib.sha256(f.read()).hexdigest()[:10]
+    secrets = {"canfleet_token": {"name": f"{args.stack}_token-{token_digest}",
+                                  "file": os.path.abspath(args.token_file)}}
+    token_mount = [{"source": "canfleet_token", "target": "canfleet_token", "mode": 0o444}]
     common_env = {
         "CANFLEET_DDS_DOMAIN": str(args.domain),
         "CANFLEET_DDS_CONFIG": "/etc/canfleet/cyclonedds-swarm.xml",
+        "CANFLEET_TOKEN_FILE": "/run/secrets/canfleet_token",
     }
     dds_mount = {"source": "dds", "target": "/etc/canfleet/cyclonedds-swarm.xml"}
     services = {}
@@ -323,9 +333,12 @@ def render(args):
                         "--log-level", args.log_level],
             "environment": dict(common_env),
             "configs": [dict(dds_mount), {"source": topo, "target": f"/etc/canfleet/swarm/{bus}.textproto"}],
+            "secrets": list(token_mount),
             "networks": ["fleet"],
             # Host mode: the ingress routing mesh needs IPVS (absent on some kernels, this project's VM
-            # included); these listen on every interface of the orchestrator's host. Firewall them.
+            # included); these listen on every interface of the orchestrator's host. The control API and
+            # the broker let in only clients with the fleet's token; socketcand has no authentication
+            # in its protocol: firewall it.
             "ports": [
                 {"target": CONTAINER_CONTROL, "published": s["ports"]["control"], "protocol": "tcp", "mode": "host"},
                 {"target": CONTAINER_BROKER, "published": s["ports"]["broker"], "protocol": "tcp", "mode": "host"},
@@ -370,6 +383,7 @@ def render(args):
             "command": ["sh", "-c", script],
             "environment": dict(common_env, CANFLEET_SLOT="{{.Task.Slot}}", CANFLEET_MAX_SLOT=str(s["max"])),
             "configs": [dict(dds_mount)],
+            "secrets": list(token_mount),
             "networks": ["fleet"],
             "stop_grace_period": "5s",
             "deploy": {
@@ -397,6 +411,7 @@ def render(args):
                 "command": [a.replace("$", "$$") for a in command],
                 "environment": dict(common_env),
                 "configs": [dict(dds_mount)],
+                "secrets": list(token_mount),
                 "networks": ["fleet"],
                 "stop_grace_period": "5s",
                 "deploy": {
@@ -417,6 +432,7 @@ def render(args):
         # network the --ip-range that keeps the monitor slots free) and removed after `stack rm`.
         "networks": {"fleet": {"external": True, "name": args.network}},
         "configs": configs,
+        "secrets": secrets,
     }
     header = (
         f"# Rendered by docker/swarm/render.py from {args.shards} for stack {args.stack}: do not edit.\n"
@@ -447,6 +463,7 @@ def main():
     p.add_argument("--domain", type=int, default=0, help="DDS domain id")
     p.add_argument("--image", default="canfleet:dev")
     p.add_argument("--log-level", default="info")
+    p.add_argument("--token-file", required=True, help="the fleet's token (made by scripts/docker-swarm.sh)")
     p.add_argument("--broker-base", type=int, default=29600, help="host port of the first bus's broker")
     p.add_argument("--control-base", type=int, default=29700, help="host port of the first bus's control API")
     p.add_argument("--socketcand-base", type=int, default=29800, help="host port of the first bus's socketcand")

@@ -14,6 +14,7 @@
 
 #include "bus/broker_client/broker_client_port.hpp"
 #include "bus/socketcan/socketcan_port.hpp"
+#include "bus/wire/auth_token.hpp"
 #include "clock/asio_scheduler.hpp"
 #include "clock/granted_scheduler.hpp"
 #include "node/canopen/lss/lss_protocol.hpp"
@@ -52,6 +53,7 @@ std::unique_ptr<BusPort> MakePort(asio::io_context& io, const node::BusSpec& spe
   client.bus = spec.bus;
   client.node_name = options.name;
   client.node_id = node::BrokerHelloNodeId(node_id);
+  client.token = options.token;
   client.virtual_time = virtual_time;
   client.virtual_time_index = index;
   auto port = std::make_unique<BrokerClientPort>(io, client);
@@ -236,13 +238,14 @@ int WriteEds(const std::string& device, const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  canfleet::node::UseOneMallocArena();  // first: before DDS or anything else starts a thread
   CLI::App app{"canfleet-node: one emulated CANopen device on a virtual or real CAN bus"};
   canfleet::node::NodeOptions options;
   std::vector<std::string> buses;
   std::vector<int> node_ids;
   std::uint32_t serial = 0;
   bool list = false, version = false;
-  std::string write_eds;
+  std::string write_eds, token_file;
   app.add_option("--device", options.device, "device variant (see --list-devices)");
   app.add_option("--eds", options.eds, "EDS file: a generic CiA 301 slave, or replaces the variant's EDS")
       ->check(CLI::ExistingFile);
@@ -251,6 +254,10 @@ int main(int argc, char** argv) {
                  "factory node-ID, see --list-devices)")
       ->check(CLI::Range(1, 255));
   app.add_option("--bus", buses, "BUS@tcp://HOST:PORT, BUS@unix:///PATH or socketcan:IFACE; one per port");
+  app.add_option(
+      "--token-file", token_file,
+      "file holding the fleet's token, for a broker beyond loopback (default: CANFLEET_TOKEN_FILE, "
+      "else CANFLEET_TOKEN)");
   app.add_option("--state-dir", options.state_dir, "folder for stored parameters (1010h) and LSS settings");
   auto* serial_opt = app.add_option("--serial", serial, "serial number (1018h sub 4)");
   app.add_option("--name", options.name, "name in logs and on the broker (default DEVICE@ID)");
@@ -307,6 +314,7 @@ int main(int argc, char** argv) {
       options.node_ids.push_back(static_cast<std::uint8_t>(id));
     }
     if (*serial_opt) options.serial_number = serial;
+    options.token = canfleet::wire::ResolveToken(token_file).value_or("");
     options.virtual_time = time_mode == "virtual";
     if (options.virtual_time && options.stdin_control)
       throw std::invalid_argument(

@@ -23,7 +23,10 @@ struct NodeOptions {
   std::vector<BusSpec> buses;          ///< --bus, one per device port
   std::filesystem::path state_dir;     ///< --state-dir
   std::optional<std::uint32_t> serial_number;
-  std::string name;             ///< --name (log prefix, broker port name)
+  std::string name;  ///< --name (log prefix, broker port name)
+  /// The fleet's token for brokers beyond loopback (--token-file, CANFLEET_TOKEN_FILE,
+  /// CANFLEET_TOKEN; bus/wire/auth_token.hpp). Empty: none.
+  std::string token{};
   std::vector<std::string> io;  ///< --io NAME=VALUE initial simulated inputs
   bool stdin_control = false;   ///< --stdin-control
   /// --factory-bit-rate: a port with no rate configured runs at the manual's factory rate rather

@@ -8,4 +8,8 @@ void ReleaseFreedHeap() {
   malloc_trim(0);
 }
 
+void UseOneMallocArena() {
+  mallopt(M_ARENA_MAX, 1);
+}
+
 }  // namespace canfleet::node

@@ -5,9 +5,11 @@
 
 #include <array>
 #include <asio/connect.hpp>
+#include <asio/write.hpp>
 #include <cerrno>
 #include <cstring>
 
+#include "bus/wire/auth_token.hpp"
 #include "orchestrator/control/duration_text.hpp"
 
 namespace canfleet::control {
@@ -53,6 +55,25 @@ ControlClient::ControlClient(const std::string& endpoint, std::chrono::milliseco
     throw ControlError("cannot connect to " + endpoint_ + ": " + ec.message() + std::string(kIsItRunning));
   asio::error_code ignored;
   socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
+  SendToken();
+}
+
+void ControlClient::SendToken() {
+  std::optional<std::string> token;
+  try {
+    token = wire::ResolveToken();
+  } catch (const std::runtime_error& e) {
+    Close();
+    throw ControlError(e.what());
+  }
+  if (!token) return;  // a loopback orchestrator needs none; one beyond it says so
+  const std::string preamble = wire::EncodeAuthPreamble(*token);
+  asio::error_code ec;
+  asio::write(socket_, asio::buffer(preamble), ec);
+  if (ec) {
+    Close();
+    throw ControlError("lost the connection to the orchestrator at " + endpoint_ + ": " + ec.message());
+  }
 }
 
 ControlClient::~ControlClient() {
@@ -79,6 +100,7 @@ std::uint64_t ControlClient::Send(Request request) {
     if (n < 0) {
       if (errno == EINTR) continue;
       const std::string why = std::strerror(errno);
+      ThrowRefusalIfAny();
       Close();
       throw ControlError("lost the connection to the orchestrator at " + endpoint_ + ": " + why);
     }
@@ -117,6 +139,20 @@ std::optional<Response> ControlClient::Receive(std::chrono::milliseconds timeout
   return NextBuffered();
 }
 
+void ControlClient::ThrowRefusalIfAny() {
+  // A refused connection (no or wrong token, too many clients) carries its reason as an error
+  // Response with id 0, which may be waiting unread when a send fails.
+  std::array<char, 4096> buffer;
+  const ssize_t n = ::recv(socket_.native_handle(), buffer.data(), buffer.size(), MSG_DONTWAIT);
+  if (n <= 0) return;
+  reader_.Append(buffer.data(), static_cast<std::size_t>(n));
+  Response r;
+  if (reader_.Next(r) == DelimitedReader::Result::kMessage && r.id() == 0 && !r.error().empty()) {
+    Close();
+    throw ControlError("the orchestrator at " + endpoint_ + " refused the connection: " + r.error());
+  }
+}
+
 std::optional<Response> ControlClient::NextBuffered() {
   Response r;
   switch (reader_.Next(r)) {
@@ -143,6 +179,10 @@ bool ControlClient::ReadSome(std::chrono::milliseconds timeout) {
   if (n == 0) {
     Close();
     throw ControlError("the orchestrator at " + endpoint_ + " closed the connection");
+  }
+  if (n < 0 && errno == ECONNRESET) {
+    Close();
+    throw ControlError("the orchestrator at " + endpoint_ + " reset the connection");
   }
   if (n < 0) {
     if (errno == EINTR || errno == EAGAIN) return false;

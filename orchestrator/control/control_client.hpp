@@ -66,6 +66,10 @@ class ControlClient {
   const std::string& endpoint() const { return endpoint_; }
 
  private:
+  /// Sends the fleet's token (wire/auth_token.hpp) when one is set in the environment.
+  void SendToken();
+  /// Throws the orchestrator's refusal if one is waiting to be read.
+  void ThrowRefusalIfAny();
   /// Reads what arrives within `timeout` into reader_; false on timeout or signal.
   bool ReadSome(std::chrono::milliseconds timeout);
   std::optional<Response> NextBuffered();

@@ -16,6 +16,16 @@ namespace {
 /// instead of spinning.
 constexpr std::chrono::milliseconds kAcceptRetry{100};
 
+/// What a refused client reads: an error Response with id 0, as for a protocol error.
+std::string RefusalBytes(const std::string& reason, std::size_t max_message) {
+  Response response;
+  response.set_id(0);
+  response.set_error("refused: " + reason);
+  std::string bytes;
+  AppendDelimited(response, bytes, max_message);
+  return bytes;
+}
+
 }  // namespace
 
 ControlServer::ControlServer(asio::io_context& io, ControlHandler& handler, ControlServerOptions options)
@@ -35,13 +45,15 @@ asio::ip::tcp::endpoint ControlServer::Listen(const std::string& endpoint) {
   const asio::ip::tcp::endpoint ep = results.begin()->endpoint();
   auto acceptor = std::make_unique<asio::ip::tcp::acceptor>(io_, ep, /*reuse_address=*/true);
   const asio::ip::tcp::endpoint bound = acceptor->local_endpoint();
-  if (!ep.address().is_loopback())
-    spdlog::warn(
-        "control API listening on tcp://{}, which other hosts can reach: anyone who can connect "
-        "can drive the fleet",
+  auto policy = wire::PolicyFor(ep.address(), options_.token, "the control API");
+  policy.handshake_timeout = options_.handshake_timeout;
+  if (policy.required)
+    spdlog::info(
+        "control API listening on tcp://{}, which other hosts can reach: clients must send the token",
         wire::TcpEndpointText(bound));
   else
     spdlog::debug("control API listening on tcp://{}", wire::TcpEndpointText(bound));
+  policies_.push_back(std::move(policy));
   acceptors_.push_back(std::move(acceptor));
   endpoints_.push_back(bound);
   Accept(acceptors_.size() - 1);
@@ -67,14 +79,52 @@ void ControlServer::Accept(std::size_t index) {
     const auto remote = socket.remote_endpoint(ignored);
     if (!ignored) peer = wire::TcpEndpointText(remote);
     stats_->accepted++;
-    const std::string label = "control session " + std::to_string(next_session_++) + " (" + peer + ")";
-    auto session =
-        std::make_shared<detail::ControlSession>(std::move(socket), handler_, options_, stats_, label,
-                                                 [this](detail::ControlSession* s) { Remove(s); });
-    sessions_.emplace(session.get(), session);
-    session->Start();
+    if (gate_stats_->pending >= options_.max_pending) {
+      // Checked before anything is allocated for the client: a flood of silent connections
+      // costs one descriptor each for at most the handshake timeout, and no more of them.
+      if (!gate_full_logged_)
+        spdlog::warn("control API: {} connections are waiting to say who they are; closing new ones ({})",
+                     options_.max_pending, peer);
+      gate_full_logged_ = true;
+      stats_->refused++;
+      socket.close(ignored);
+    } else {
+      gate_full_logged_ = false;
+      wire::AuthGateHandlers<asio::ip::tcp::socket> handlers;
+      handlers.admit = [this, peer, alive](asio::ip::tcp::socket admitted) {
+        if (!alive.expired() && !closed_) Admit(std::move(admitted), peer);
+      };
+      handlers.refusal = [max = options_.max_message](const std::string& reason) {
+        return RefusalBytes(reason, max);
+      };
+      handlers.log_refusal = [stats = stats_, peer](const std::string& reason) {
+        stats->refused++;
+        spdlog::warn("control API: refused {}: {}", peer, reason);
+      };
+      wire::AuthGate<asio::ip::tcp::socket>::Run(std::move(socket), policies_[index], std::move(handlers),
+                                                 gate_stats_);
+    }
     Accept(index);
   });
+}
+
+void ControlServer::Admit(asio::ip::tcp::socket socket, const std::string& peer) {
+  if (sessions_.size() >= options_.max_sessions) {
+    const std::string reason = "too many connections to this control API (limit " +
+                               std::to_string(options_.max_sessions) + "); close one and try again";
+    stats_->refused++;
+    spdlog::warn("control API: refused {}: {}", peer, reason);
+    const std::string bytes = RefusalBytes(reason, options_.max_message);
+    asio::error_code ignored;
+    socket.send(asio::buffer(bytes), asio::socket_base::message_flags(MSG_DONTWAIT | MSG_NOSIGNAL), ignored);
+    socket.close(ignored);
+    return;
+  }
+  const std::string label = "control session " + std::to_string(next_session_++) + " (" + peer + ")";
+  auto session = std::make_shared<detail::ControlSession>(
+      std::move(socket), handler_, options_, stats_, label, [this](detail::ControlSession* s) { Remove(s); });
+  sessions_.emplace(session.get(), session);
+  session->Start();
 }
 
 void ControlServer::Remove(detail::ControlSession* session) {

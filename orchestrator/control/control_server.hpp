@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bus/wire/auth_gate.hpp"
 #include "orchestrator/control/control_handler.hpp"
 #include "orchestrator/control/control_protocol.hpp"
 
@@ -29,6 +30,15 @@ struct ControlServerOptions {
   /// When a connection is closed by the server (protocol error, Close), how long what is queued
   /// (an error response, a Shutdown's Done) may take to leave before the socket is closed anyway.
   std::chrono::milliseconds close_linger{1'000};
+  /// The fleet's token (bus/wire/auth_token.hpp). Listening beyond loopback needs one; clients
+  /// there must send it (wire/auth_gate.hpp). Empty: loopback only.
+  std::string token{};
+  /// From accept until the client's first bytes (its token, or its first request on loopback).
+  std::chrono::milliseconds handshake_timeout{10'000};
+  /// Connections waiting at the gate at once; one more is closed at once.
+  std::size_t max_pending = 64;
+  /// Sessions at once; one more is refused with an error Response saying so.
+  std::size_t max_sessions = 128;
 };
 
 struct ControlServerStats {
@@ -36,6 +46,7 @@ struct ControlServerStats {
   std::uint64_t requests = 0;         ///< requests handed to the handler
   std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or oversized messages
   std::uint64_t dropped_batches = 0;  ///< FrameBatch responses not queued for slow readers
+  std::uint64_t refused = 0;          ///< connections refused: no or wrong token, too many
 };
 
 /// Accepts connections and runs one session per connection, as asio's chat_server does: each
@@ -58,10 +69,11 @@ class ControlServer {
   ControlServer& operator=(const ControlServer&) = delete;
 
   /// Starts accepting on `endpoint`, `tcp://HOST:PORT` (port 0: any free port) and returns where
-  /// it listens. Loopback unless another address is given explicitly; a non-loopback address is
-  /// logged as reachable from other hosts. May be called more than once (several addresses).
-  /// Throws std::invalid_argument for a malformed endpoint and std::system_error when it cannot
-  /// be resolved or bound.
+  /// it listens. Loopback unless another address is given explicitly; beyond loopback every
+  /// client must send the token (ControlServerOptions::token). May be called more than once
+  /// (several addresses). Throws std::invalid_argument for a malformed endpoint,
+  /// std::runtime_error for an address beyond loopback without a token, and std::system_error
+  /// when it cannot be resolved or bound.
   asio::ip::tcp::endpoint Listen(const std::string& endpoint);
 
   /// Stops accepting and closes every connection (OnClose handlers run now; what is already
@@ -71,9 +83,11 @@ class ControlServer {
   std::size_t SessionCount() const { return sessions_.size(); }
   const std::vector<asio::ip::tcp::endpoint>& Endpoints() const { return endpoints_; }
   const ControlServerStats& Stats() const { return *stats_; }
+  const wire::AuthGateStats& GateStats() const { return *gate_stats_; }
 
  private:
   void Accept(std::size_t index);
+  void Admit(asio::ip::tcp::socket socket, const std::string& peer);
   void Remove(detail::ControlSession* session);
 
   asio::io_context& io_;
@@ -84,9 +98,12 @@ class ControlServer {
   std::shared_ptr<int> alive_ = std::make_shared<int>(0);
   std::vector<std::unique_ptr<asio::ip::tcp::acceptor>> acceptors_;
   std::vector<asio::ip::tcp::endpoint> endpoints_;
+  std::vector<wire::AuthPolicy> policies_;  ///< one per acceptor
+  std::shared_ptr<wire::AuthGateStats> gate_stats_ = std::make_shared<wire::AuthGateStats>();
   std::unordered_map<detail::ControlSession*, std::shared_ptr<detail::ControlSession>> sessions_;
   std::uint64_t next_session_ = 1;
   bool closed_ = false;
+  bool gate_full_logged_ = false;
 };
 
 }  // namespace canfleet::control

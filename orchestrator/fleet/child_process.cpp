@@ -12,6 +12,14 @@
 
 namespace canfleet::fleet {
 
+namespace {
+
+/// The highest descriptor closed one by one where close_range is missing (the default soft limit
+/// of open files is 1024; the orchestrator raises none).
+constexpr int kMaxInheritedFd = 65536;
+
+}  // namespace
+
 pid_t SpawnChild(const LaunchSpec& spec) {
   // Everything the child needs is prepared before fork: between fork and exec only
   // async-signal-safe calls are allowed (the orchestrator has DDS and Asio threads).
@@ -49,6 +57,14 @@ pid_t SpawnChild(const LaunchSpec& spec) {
     if (null >= 0) ::dup2(null, STDIN_FILENO);
     ::dup2(log, STDOUT_FILENO);
     ::dup2(log, STDERR_FILENO);
+    // Nothing else of the orchestrator's goes along: Asio opens its sockets without close-on-exec,
+    // and a node holding the control, broker or socketcand listeners (or other clients'
+    // connections) would keep the fleet's ports bound after the orchestrator ended. close_range
+    // where the kernel has it (5.9), else one close per possible descriptor.
+    if (::close_range(3, ~0U, 0) != 0) {
+      for (int fd = 3; fd < kMaxInheritedFd; ++fd)
+        ::close(fd);
+    }
     // The orchestrator's signal mask and dispositions are not the node's.
     sigset_t none;
     sigemptyset(&none);

@@ -51,6 +51,13 @@ RestartPolicy PolicyOf(const topology::Node& node) {
   return policy;
 }
 
+CaptureFolders CaptureFoldersOf(const FleetOptions& options) {
+  if (options.capture_folders) return *options.capture_folders;
+  const std::filesystem::path root =
+      std::filesystem::absolute(options.topology.orchestrator().state_root()).lexically_normal();
+  return {root / "captures", {root}};
+}
+
 }  // namespace
 
 Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
@@ -88,7 +95,7 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
                             awaited_clock_.erase(it);
                           },
                   }),
-      captures_(broker, wall_origin_) {
+      captures_(broker, wall_origin_, CaptureFoldersOf(options_)) {
   for (const auto& spec : options_.topology.node()) {
     FleetNode node;
     node.spec = spec;

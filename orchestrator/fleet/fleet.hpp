@@ -58,6 +58,9 @@ struct FleetOptions {
   /// The topology file as given (`canfleet up FILE`, `canfleet test FILE`): result lines and
   /// telemetry's verdicts name it. Empty: the topology's name.
   std::string scenario_source;
+  /// Where the control API may have captures written (capture_path.hpp). Default: base
+  /// <state root>/captures, allowed the state root.
+  std::optional<CaptureFolders> capture_folders;
   /// The line of each scenario step in that file (topology::LoadedTopology::step_lines).
   std::vector<int> step_lines;
 };

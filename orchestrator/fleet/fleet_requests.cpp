@@ -197,6 +197,7 @@ control::Status Fleet::Status() const {
       const NodeLiveState* live = tracker_.Find(bus, node.node_ids[p]);
       port->set_booted(live && live->booted);
       port->set_nmt_state(NmtStateName(live ? live->nmt_state : std::nullopt));
+      port->set_nmt_stale(live && live->Stale(scheduler_.Now()));
       port->set_heartbeat_age_s(
           live && live->last_heartbeat
               ? std::chrono::duration<double>(scheduler_.Now() - *live->last_heartbeat).count()
@@ -217,6 +218,7 @@ control::Status Fleet::Status() const {
     out->set_rec(first.rec());
     out->set_booted(first.booted());
     out->set_nmt_state(first.nmt_state());
+    out->set_nmt_stale(first.nmt_stale());
     out->set_heartbeat_age_s(first.heartbeat_age_s());
     if (first.has_last_emcy()) *out->mutable_last_emcy() = first.last_emcy();
     out->set_emcy_count(first.emcy_count());

@@ -77,11 +77,12 @@ control::CaptureStarted Captures::Start(const control::CaptureStart& request) {
   const auto buses = broker_.Buses();
   if (std::find(buses.begin(), buses.end(), request.bus()) == buses.end())
     throw std::invalid_argument("no bus called '" + request.bus() + "'");
-  if (request.path().empty()) throw std::invalid_argument("capture needs a file (--file)");
   const std::string format = request.format().empty() ? "pcap" : request.format();
+  if (format != "pcap" && format != "candump")
+    throw std::invalid_argument("capture format '" + format + "': pcap or candump");
   Capture capture;
   capture.bus = request.bus();
-  capture.path = std::filesystem::absolute(request.path()).string();
+  capture.path = ResolveCapturePath(request.path(), folders_).string();
   if (format == "pcap") {
     capture.writer = std::make_unique<capture::PcapWriter>(capture.path);
   } else if (format == "candump") {

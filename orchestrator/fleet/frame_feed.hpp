@@ -13,6 +13,7 @@
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/capture/capture_tap.hpp"
 #include "orchestrator/control/control_handler.hpp"
+#include "orchestrator/fleet/capture_path.hpp"
 
 namespace canfleet::fleet {
 
@@ -37,11 +38,14 @@ class DumpSubscription {
 /// Capture files, by id.
 class Captures {
  public:
-  Captures(broker::Broker& broker, capture::WallTime origin) : broker_(broker), origin_(origin) {}
+  Captures(broker::Broker& broker, capture::WallTime origin, CaptureFolders folders)
+      : broker_(broker), origin_(origin), folders_(std::move(folders)) {}
   ~Captures();
 
-  /// Starts writing `bus` to `path` ("pcap" or "candump"). Returns the id and the absolute path.
-  /// @throws std::invalid_argument (unknown bus or format) or std::system_error (file).
+  /// Starts writing `bus` to `path` ("pcap" or "candump"), a file that must not exist yet inside
+  /// the fleet's folders (capture_path.hpp; relative: in the capture folder). Returns the id and
+  /// the absolute path. @throws std::invalid_argument (unknown bus or format, a path refused) or
+  /// std::system_error (file).
   control::CaptureStarted Start(const control::CaptureStart& request);
   /// Stops one capture (0: every one). Returns a line for the CLI. @throws std::invalid_argument.
   std::string Stop(std::uint32_t id);
@@ -58,6 +62,7 @@ class Captures {
 
   broker::Broker& broker_;
   capture::WallTime origin_;
+  CaptureFolders folders_;
   std::map<std::uint32_t, Capture> captures_;
   std::uint32_t next_id_ = 1;
 };

@@ -1,5 +1,7 @@
 #include "orchestrator/fleet/node_tracker.hpp"
 
+#include <algorithm>
+
 namespace canfleet::fleet {
 
 const char* NmtStateName(std::optional<std::uint8_t> state) {
@@ -27,6 +29,14 @@ void NodeTracker::Observe(const std::string& bus, const CanFrame& frame, TimePoi
     const auto node_id = static_cast<std::uint8_t>(id - 0x700);
     const auto state = static_cast<std::uint8_t>(frame.data[0] & 0x7F);
     auto& live = nodes_[{bus, node_id}];
+    if (state == 0x00) {  // a boot-up starts over
+      live.heartbeat_period.reset();
+      live.last_interval.reset();
+    } else if (live.last_heartbeat && now > *live.last_heartbeat) {
+      const Duration interval = now - *live.last_heartbeat;
+      live.heartbeat_period = live.last_interval ? std::min(interval, *live.last_interval) : interval;
+      live.last_interval = interval;
+    }
     live.nmt_state = state;
     live.last_heartbeat = now;
     if (state == 0x00) {

@@ -27,8 +27,20 @@ struct NodeLiveState {
   bool booted = false;                      ///< a boot-up frame was seen since Forget()
   std::optional<std::uint8_t> nmt_state;    ///< last heartbeat/boot-up state byte (00h, 04h, 05h, 7Fh)
   std::optional<TimePoint> last_heartbeat;  ///< or boot-up
+  /// The producer time as seen on the wire: the shorter of the last two intervals between
+  /// heartbeats (a gap, which is what staleness is about, does not stretch it; a producer time
+  /// changed for good is taken after two heartbeats).
+  std::optional<Duration> heartbeat_period;
+  std::optional<Duration> last_interval;
   std::optional<SeenEmcy> last_emcy;
   std::uint64_t emcy_count = 0;
+
+  /// The NMT state is old news: a node that has been sending heartbeats has sent none for three
+  /// of its periods (a flood, a partition, a hung process). `canfleet status` says so rather than
+  /// show a state it has not seen recently. A node without periodic heartbeats is never stale.
+  bool Stale(TimePoint now) const {
+    return heartbeat_period && last_heartbeat && now - *last_heartbeat > 3 * *heartbeat_period;
+  }
 };
 
 /// "pre-operational", "operational", "stopped", "initialising" (boot-up), "unknown".

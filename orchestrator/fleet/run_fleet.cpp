@@ -125,6 +125,7 @@ int RunFleet(const UpOptions& options) {
       if (bus.socketcand_port() != 0)
         host.ServeSocketcand(bus.name(), static_cast<std::uint16_t>(bus.socketcand_port()));
     }
+    host.server().SetToken(options.token);
     for (const auto& listen : spec.orchestrator().listen())
       host.Listen(wire::Endpoint::Parse(listen));
     broker_endpoint = host.Endpoints().front().ToString();
@@ -140,11 +141,17 @@ int RunFleet(const UpOptions& options) {
     fleet_options.seed = spec.time().seed();
     fleet_options.scenario_source = options.topology.string();
     fleet_options.step_lines = loaded.step_lines;
+    if (!options.capture_dir.empty()) {
+      const auto dir = std::filesystem::absolute(options.capture_dir).lexically_normal();
+      fleet_options.capture_folders = CaptureFolders{
+          dir, {dir, std::filesystem::absolute(spec.orchestrator().state_root()).lexically_normal()}};
+    }
     UseHostTime(fleet_options, host.conductor());
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));
     control_server =
-        std::make_unique<control::ControlServer>(io, ControlHandlerFor(*fleet, host.conductor(), boundary));
+        std::make_unique<control::ControlServer>(io, ControlHandlerFor(*fleet, host.conductor(), boundary),
+                                                 control::ControlServerOptions{.token = options.token});
     const auto bound = control_server->Listen(spec.orchestrator().control());
     control_endpoint = "tcp://" + wire::TcpEndpointText(bound);
   } catch (const std::exception& e) {

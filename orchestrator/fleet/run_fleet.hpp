@@ -18,8 +18,14 @@ struct UpOptions {
   std::optional<std::string> control;         ///< overrides Orchestrator.control (e.g. tcp://127.0.0.1:0)
   std::optional<std::string> listen;          ///< overrides Orchestrator.listen (one broker endpoint)
   std::string socketcand_bind = "127.0.0.1";  ///< address the buses' socketcand endpoints listen on
-  std::filesystem::path node_binary;          ///< canfleet-node; empty: beside this executable, then PATH
-  std::filesystem::path ready_file;  ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
+  /// The fleet's token (bus/wire/auth_token.hpp): needed, and then required of every client, when
+  /// the control API or the broker listens beyond loopback. Empty: loopback only.
+  std::string token{};
+  /// Where captures asked for over the control API go (a relative file) and may go (besides the
+  /// state root). Empty: <state root>/captures.
+  std::filesystem::path capture_dir{};
+  std::filesystem::path node_binary;  ///< canfleet-node; empty: beside this executable, then PATH
+  std::filesystem::path ready_file;   ///< once every node booted: "control <endpoint>\nbroker <endpoint>\n"
   std::string log_level = "info";
   bool no_start = false;  ///< load and start the buses, but no node processes
   /// Virtual time: from the moment the fleet is ready, time runs only inside a client's

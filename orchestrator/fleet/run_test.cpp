@@ -145,6 +145,11 @@ class FileRun {
       fleet_options.seed = options_.seed ? *options_.seed : spec.time().seed();
       fleet_options.scenario_source = report_.file;
       fleet_options.step_lines = lines_;
+      if (!options_.capture.empty()) {
+        const auto dir = fs::absolute(options_.capture).lexically_normal();
+        fleet_options.capture_folders =
+            CaptureFolders{dir, {dir, fs::absolute(spec.orchestrator().state_root()).lexically_normal()}};
+      }
       UseHostTime(fleet_options, host.conductor());
       fleet = std::make_unique<Fleet>(io, scheduler, host.broker(), host.server(), std::move(fleet_options));
       control_server =
@@ -155,7 +160,9 @@ class FileRun {
           control::CaptureStart capture;
           capture.set_bus(bus.name());
           capture.set_format("candump");
-          capture.set_path((options_.capture / (file_.stem().string() + "-" + bus.name() + ".log")).string());
+          capture.set_path(
+              (fs::absolute(options_.capture) / (file_.stem().string() + "-" + bus.name() + ".log"))
+                  .string());
           fleet->StartCapture(capture);
         }
       }

@@ -23,7 +23,7 @@ void Supervisor::Add(const std::string& name, LaunchSpec launch, RestartPolicy p
   node.name = name;
   node.launch = std::move(launch);
   node.policy = policy;
-  node.next_backoff = policy.backoff;
+  node.restart_backoff = RestartBackoff(policy.backoff);
   nodes_.emplace(name, std::move(node));
 }
 
@@ -43,6 +43,7 @@ bool Supervisor::Start(const std::string& name, std::string* error) {
     return false;
   }
   node.state = State::kRunning;
+  node.started_at = scheduler_.Now();
   node.then = Then::kPolicy;
   node.detail.clear();
   spdlog::info("{}: started, pid {} (log {})", name, node.pid, node.launch.log_file.string());
@@ -223,8 +224,7 @@ void Supervisor::OnEnded(Node& node, int status) {
     return;
   }
   node.state = State::kBackoff;
-  const auto delay = node.next_backoff;
-  node.next_backoff = std::min(kMaxBackoff, node.next_backoff * 2);
+  const auto delay = node.restart_backoff.After(scheduler_.Now() - node.started_at);
   ++node.restarts;
   node.detail =
       how + ", restart " + std::to_string(node.restarts) + " in " + std::to_string(delay.count()) + " ms";

@@ -16,13 +16,16 @@
 
 #include "clock/scheduler.hpp"
 #include "orchestrator/fleet/child_process.hpp"
+#include "orchestrator/fleet/restart_backoff.hpp"
 
 namespace canfleet::fleet {
 
 struct RestartPolicy {
-  bool on_failure = false;                 ///< restart after a non-zero exit or a signal
-  std::uint32_t max_restarts = 0;          ///< 0 = no limit
-  std::chrono::milliseconds backoff{500};  ///< first delay, doubled each time up to kMaxBackoff
+  bool on_failure = false;         ///< restart after a non-zero exit or a signal
+  std::uint32_t max_restarts = 0;  ///< 0 = no limit
+  /// First delay, doubled each time up to RestartBackoff::kMaxDelay, and the first again after a
+  /// run of RestartBackoff::kStablePeriod (restart_backoff.hpp).
+  std::chrono::milliseconds backoff{500};
 };
 
 /// What `canfleet status` shows of a process.
@@ -42,7 +45,6 @@ class Supervisor {
     std::function<void(const std::string& name, const std::string& how, bool expected)> ended;
   };
 
-  static constexpr std::chrono::milliseconds kMaxBackoff{10'000};
   /// How long a node may take to stop after SIGTERM before it gets SIGKILL.
   static constexpr std::chrono::milliseconds kStopGrace{5'000};
 
@@ -80,7 +82,8 @@ class Supervisor {
     Then then = Then::kPolicy;
     pid_t pid = 0;
     std::uint32_t restarts = 0;
-    std::chrono::milliseconds next_backoff{0};
+    RestartBackoff restart_backoff{std::chrono::milliseconds(0)};
+    TimePoint started_at{};  ///< scheduler time of the last start
     std::string detail;
     std::unique_ptr<Timer> backoff;
     std::unique_ptr<Timer> kill_after_grace;

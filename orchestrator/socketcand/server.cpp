@@ -105,6 +105,13 @@ std::uint16_t Server::Serve(std::string_view bus, std::optional<std::uint16_t> p
   listeners_.push_back(listener);
   listener->Accept();
   spdlog::info("socketcand: serving {} on {}:{}", bus, context_->options.bind_address, bound);
+  if (!endpoint.address().is_loopback())
+    // The socketcand protocol has no authentication: whoever reaches this port can read and write
+    // the bus. Asked for explicitly (--socketcand-bind), so said plainly rather than refused.
+    spdlog::warn(
+        "socketcand: {} on {}:{} is reachable from other hosts and the socketcand protocol has no "
+        "authentication: anyone who reaches it can send frames on {} (keep it on 127.0.0.1, or firewall it)",
+        bus, context_->options.bind_address, bound, bus);
   return bound;
 }
 

@@ -9,6 +9,7 @@
 #include <asio/steady_timer.hpp>
 #include <stdexcept>
 
+#include "bus/wire/message_writer.hpp"
 #include "bus/wire/tcp_endpoint_text.hpp"
 #include "orchestrator/transport/node_session.hpp"
 #include "orchestrator/transport/unix_socket_path.hpp"
@@ -20,6 +21,18 @@ namespace {
 /// After a failed accept (e.g. out of file descriptors), wait this long before the next one
 /// instead of spinning.
 constexpr std::chrono::milliseconds kAcceptRetry{100};
+
+/// What a refused client reads: the HelloReply it waits for, refused with the reason.
+std::string RefusalBytes(const std::string& reason) {
+  wire::HelloReply reply;
+  reply.set_accepted(false);
+  reply.set_reason(reason);
+  reply.set_protocol_version(wire::kProtocolVersion);
+  wire::MessageWriter writer;
+  writer.AddHelloReply(reply);
+  const auto bytes = writer.Bytes();
+  return std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
 
 }  // namespace
 
@@ -41,9 +54,12 @@ wire::Endpoint BrokerServer::Listen(const wire::Endpoint& endpoint) {
     const asio::ip::tcp::endpoint ep = results.begin()->endpoint();
     auto acceptor = std::make_unique<asio::ip::tcp::acceptor>(io_, ep, /*reuse_address=*/true);
     bound.port = acceptor->local_endpoint().port();
-    if (!ep.address().is_loopback())
-      spdlog::warn("listening on {}, which other hosts can reach: anyone who can connect can join the buses",
+    auto policy = wire::PolicyFor(ep.address(), options_.token, "the broker");
+    policy.handshake_timeout = options_.hello_timeout;
+    if (policy.required)
+      spdlog::info("listening on {}, which other hosts can reach: nodes and tools must send the token",
                    bound.ToString());
+    tcp_policies_.push_back(std::move(policy));
     tcp_.push_back(std::move(acceptor));
     AcceptTcp(tcp_.size() - 1);
   } else {
@@ -63,27 +79,54 @@ void BrokerServer::AcceptTcp(std::size_t index) {
   tcp_[index]->async_accept([this, index, alive = std::weak_ptr<int>(alive_)](const asio::error_code& ec,
                                                                               asio::ip::tcp::socket socket) {
     if (alive.expired() || closed_) return;
-    std::string peer = "tcp";
-    asio::generic::stream_protocol::socket generic(io_);
-    if (!ec) {
-      asio::error_code ignored;
-      socket.set_option(asio::ip::tcp::no_delay(true), ignored);  // batches are whole when written
-      const auto remote = socket.remote_endpoint(ignored);
-      if (!ignored) peer = "tcp " + wire::TcpEndpointText(remote);
-      const auto protocol = socket.local_endpoint(ignored).protocol();
-      generic = asio::generic::stream_protocol::socket(
-          io_, asio::generic::stream_protocol(protocol.family(), protocol.protocol()), socket.release());
-    }
-    OnAccept(ec, std::move(peer), std::move(generic));
     if (ec) {
+      OnAccept(ec, "tcp", asio::generic::stream_protocol::socket(io_));
       auto timer = std::make_shared<asio::steady_timer>(io_, kAcceptRetry);
       timer->async_wait([this, index, timer, alive](const asio::error_code& wait_ec) {
         if (!wait_ec && !alive.expired() && !closed_) AcceptTcp(index);
       });
       return;
     }
+    asio::error_code ignored;
+    socket.set_option(asio::ip::tcp::no_delay(true), ignored);  // batches are whole when written
+    std::string peer = "tcp";
+    const auto remote = socket.remote_endpoint(ignored);
+    if (!ignored) peer = "tcp " + wire::TcpEndpointText(remote);
+    Gate(index, std::move(peer), std::move(socket));
     AcceptTcp(index);
   });
+}
+
+void BrokerServer::Gate(std::size_t index, std::string peer, asio::ip::tcp::socket socket) {
+  if (gate_stats_->pending >= options_.max_pending) {
+    // Checked before anything is allocated for the client (see ControlServer::Accept).
+    if (!gate_full_logged_)
+      spdlog::warn("{} connections are waiting to say who they are; closing new ones ({})",
+                   options_.max_pending, peer);
+    gate_full_logged_ = true;
+    stats_->refused_connections++;
+    asio::error_code ignored;
+    socket.close(ignored);
+    return;
+  }
+  gate_full_logged_ = false;
+  wire::AuthGateHandlers<asio::ip::tcp::socket> handlers;
+  handlers.admit = [this, peer, alive = std::weak_ptr<int>(alive_)](asio::ip::tcp::socket admitted) {
+    if (alive.expired() || closed_) return;
+    asio::error_code ignored;
+    const auto protocol = admitted.local_endpoint(ignored).protocol();
+    OnAccept(
+        {}, peer,
+        asio::generic::stream_protocol::socket(
+            io_, asio::generic::stream_protocol(protocol.family(), protocol.protocol()), admitted.release()));
+  };
+  handlers.refusal = [](const std::string& reason) { return RefusalBytes(reason); };
+  handlers.log_refusal = [stats = stats_, peer](const std::string& reason) {
+    stats->refused_connections++;
+    spdlog::warn("refused {}: {}", peer, reason);
+  };
+  wire::AuthGate<asio::ip::tcp::socket>::Run(std::move(socket), tcp_policies_[index], std::move(handlers),
+                                             gate_stats_);
 }
 
 void BrokerServer::AcceptUnix(std::size_t index) {
@@ -113,6 +156,17 @@ void BrokerServer::OnAccept(const asio::error_code& ec, std::string peer,
     return;
   }
   stats_->accepted++;
+  if (sessions_.size() >= options_.max_sessions) {
+    const std::string reason =
+        "too many connections to this broker (limit " + std::to_string(options_.max_sessions) + ")";
+    stats_->refused_connections++;
+    spdlog::warn("refused {}: {}", peer, reason);
+    const std::string bytes = RefusalBytes(reason);
+    asio::error_code ignored;
+    socket.send(asio::buffer(bytes), asio::socket_base::message_flags(MSG_DONTWAIT | MSG_NOSIGNAL), ignored);
+    socket.close(ignored);
+    return;
+  }
   const std::string label = "session " + std::to_string(next_session_++) + " (" + peer + ")";
   auto session = std::make_shared<detail::NodeSession>(
       broker_, options_, stats_, std::move(socket), label, [this](detail::NodeSession* s) { Remove(s); },

@@ -16,6 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bus/wire/auth_gate.hpp"
 #include "bus/wire/endpoint.hpp"
 #include "bus/wire/messages.hpp"
 #include "clock/wall_clock.hpp"
@@ -46,22 +47,31 @@ struct BrokerServerOptions {
   /// HelloReply (wall_origin_ns) so that it stamps received frames as captures do. The epoch (0)
   /// in virtual time and when unknown.
   WallTime wall_origin{};
+  /// The fleet's token (bus/wire/auth_token.hpp). A TCP listener beyond loopback needs one, and
+  /// its clients must send it before their Hello (wire/auth_gate.hpp); Unix sockets need none.
+  std::string token{};
+  /// TCP connections waiting at the gate at once; one more is closed at once.
+  std::size_t max_pending = 64;
+  /// Sessions at once (every bus of this broker: up to 127 nodes each, plus tools); one more is
+  /// refused with a HelloReply saying so.
+  std::size_t max_sessions = 1024;
 };
 
 struct BrokerServerStats {
-  std::uint64_t accepted = 0;         ///< connections accepted
-  std::uint64_t attached = 0;         ///< Hellos accepted
-  std::uint64_t refused = 0;          ///< Hellos refused (version, unknown bus, bad names)
-  std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or out-of-order data
-  std::uint64_t backlog_drops = 0;    ///< frames not sent to slow readers
-  std::uint64_t filtered_frames = 0;  ///< frames not sent to a node whose acceptance filter rejects them
-  std::uint64_t node_requests = 0;    ///< RequestNode calls
-  std::uint64_t node_replies = 0;     ///< of those, answered by the node (error or not)
-  std::uint64_t reads = 0;            ///< recv calls on sessions
-  std::uint64_t empty_reads = 0;      ///< of those, found nothing to read (EAGAIN)
-  std::uint64_t writes = 0;           ///< send calls on sessions
-  std::uint64_t gathered_writes = 0;  ///< of those, straight from a round's shared encoding
-  std::uint64_t partial_writes = 0;   ///< of those, taken only in part by the socket (slow reader)
+  std::uint64_t accepted = 0;             ///< connections accepted
+  std::uint64_t attached = 0;             ///< Hellos accepted
+  std::uint64_t refused = 0;              ///< Hellos refused (version, unknown bus, bad names)
+  std::uint64_t refused_connections = 0;  ///< refused before a Hello: no or wrong token, too many
+  std::uint64_t protocol_errors = 0;      ///< connections closed for malformed or out-of-order data
+  std::uint64_t backlog_drops = 0;        ///< frames not sent to slow readers
+  std::uint64_t filtered_frames = 0;      ///< frames not sent to a node whose acceptance filter rejects them
+  std::uint64_t node_requests = 0;        ///< RequestNode calls
+  std::uint64_t node_replies = 0;         ///< of those, answered by the node (error or not)
+  std::uint64_t reads = 0;                ///< recv calls on sessions
+  std::uint64_t empty_reads = 0;          ///< of those, found nothing to read (EAGAIN)
+  std::uint64_t writes = 0;               ///< send calls on sessions
+  std::uint64_t gathered_writes = 0;      ///< of those, straight from a round's shared encoding
+  std::uint64_t partial_writes = 0;       ///< of those, taken only in part by the socket (slow reader)
 };
 
 /// Called once per RequestNode: the node's reply, or nullopt when no node of that name is
@@ -108,12 +118,17 @@ class BrokerServer {
 
   std::size_t SessionCount() const { return sessions_.size(); }
   const std::vector<wire::Endpoint>& Endpoints() const { return endpoints_; }
+  /// The fleet's token (BrokerServerOptions::token), for the listeners opened after this call.
+  void SetToken(std::string token) { options_.token = std::move(token); }
+  const wire::AuthGateStats& GateStats() const { return *gate_stats_; }
   const BrokerServerStats& Stats() const { return *stats_; }
 
  private:
   void AcceptTcp(std::size_t index);
   void AcceptUnix(std::size_t index);
   void OnAccept(const asio::error_code& ec, std::string peer, asio::generic::stream_protocol::socket socket);
+  /// Passes a TCP client through the auth gate (wire/auth_gate.hpp) to OnAccept.
+  void Gate(std::size_t index, std::string peer, asio::ip::tcp::socket socket);
   void Remove(detail::NodeSession* session);
 
   asio::io_context& io_;
@@ -124,6 +139,9 @@ class BrokerServer {
   /// Owned by the server alone: acceptor handlers that outlive it see it expired.
   std::shared_ptr<int> alive_ = std::make_shared<int>(0);
   std::vector<std::unique_ptr<asio::ip::tcp::acceptor>> tcp_;
+  std::vector<wire::AuthPolicy> tcp_policies_;  ///< one per TCP acceptor
+  std::shared_ptr<wire::AuthGateStats> gate_stats_ = std::make_shared<wire::AuthGateStats>();
+  bool gate_full_logged_ = false;
   std::vector<std::unique_ptr<asio::local::stream_protocol::acceptor>> unix_;
   std::vector<std::string> unix_paths_;  ///< socket files to remove on Close
   std::vector<wire::Endpoint> endpoints_;

@@ -139,6 +139,8 @@ class CanfleetBus(can.BusABC):
         must not be the name of a topology node. Default python-can-<pid>-<n>.
     :param bitrate: the controller's bit rate in bit/s; default: the bus's (a different rate sees
         only error frames, as a real controller would).
+    :param token: the fleet's token, for a broker that listens beyond loopback; default: from
+        CANFLEET_TOKEN_FILE or CANFLEET_TOKEN (canfleet.auth).
     :param receive_own_messages: also receive own frames once they were on the bus (TX
         confirmations, with their bus timestamp, is_rx False).
     :param can_filters: python-can filters; they become the broker's acceptance filter.
@@ -147,12 +149,13 @@ class CanfleetBus(can.BusABC):
     def __init__(self, channel: str, can_filters: Optional[Any] = None, *, broker: Optional[str] = None,
                  fleet: Optional[Any] = None, name: Optional[str] = None, bitrate: int = 0,
                  receive_own_messages: bool = False, connect_timeout: float = CONNECT_TIMEOUT,
-                 **kwargs: Any) -> None:
+                 token: Optional[str] = None, **kwargs: Any) -> None:
         if not isinstance(channel, str) or not channel:
             raise CanInitializationError("canfleet: channel must be the bus's name, e.g. 'can0'")
         self.channel = channel
         self.channel_info = f"canfleet bus {channel}"
         self.name = name or f"python-can-{os.getpid()}-{next(_names)}"
+        self._token = token
         self.endpoint, fleet = _broker_endpoint(broker, fleet)
         #: The driven fleet's simulated clock (virtual time), else None: waits are real-time waits.
         self.clock: Optional[Clock] = fleet.clock if fleet is not None else None
@@ -168,7 +171,7 @@ class CanfleetBus(can.BusABC):
         self._wall_origin_ns = 0
         self._closing = False
         try:
-            self._sock = endpoints.connect(self.endpoint, connect_timeout)
+            self._sock = endpoints.connect(self.endpoint, connect_timeout, self._token)
         except (OSError, ValueError) as e:
             raise CanInitializationError(f"canfleet: no broker at {self.endpoint} ({e})") from None
         self._reader = DelimitedReader()

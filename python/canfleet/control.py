@@ -18,9 +18,12 @@ DEFAULT_TIMEOUT = 30.0  # seconds, as the CLI's --timeout (an SDO block transfer
 class ControlClient:
     """Request/response over one connection to the control API at `endpoint` (tcp://HOST:PORT)."""
 
-    def __init__(self, endpoint: str, timeout: float = DEFAULT_TIMEOUT) -> None:
+    def __init__(self, endpoint: str, timeout: float = DEFAULT_TIMEOUT, token: Optional[str] = None) -> None:
+        """`token`: the fleet's, for an orchestrator beyond loopback; None: from the environment
+        (canfleet.auth.resolve: CANFLEET_TOKEN_FILE, CANFLEET_TOKEN)."""
         self.endpoint = endpoint
         self.timeout = timeout
+        self.token = token
         self._lock = threading.Lock()
         self._sock: Optional[socket.socket] = None
         self._reader = DelimitedReader()
@@ -29,7 +32,7 @@ class ControlClient:
     def _connect(self) -> socket.socket:
         if self._sock is None:
             try:
-                self._sock = endpoints.connect(self.endpoint, self.timeout)
+                self._sock = endpoints.connect(self.endpoint, self.timeout, self.token)
             except OSError as e:
                 raise NotReachableError(f"no orchestrator at {self.endpoint} ({e.strerror or e})") from None
             self._reader = DelimitedReader()
@@ -47,8 +50,14 @@ class ControlClient:
                 sock.settimeout(timeout if timeout is not None else self.timeout)
                 sock.sendall(delimited(request.SerializeToString()))
                 response = self._receive(sock, request.id)
-            except (OSError, FramingError) as e:
+            except OrchestratorError:
                 self._drop()
+                raise
+            except (OSError, FramingError) as e:
+                refusal = self._refusal(sock)
+                self._drop()
+                if refusal:
+                    raise OrchestratorError(f"the orchestrator at {self.endpoint} {refusal}") from None
                 raise NotReachableError(f"control connection to {self.endpoint} failed: {e}") from None
         if response.error:
             raise SdoAbortError.parse(response.error, request.WhichOneof("body") or "")
@@ -62,11 +71,34 @@ class ControlClient:
                 response.ParseFromString(body)
                 if response.id == request_id:
                     return response
+                if response.id == 0 and response.error:
+                    # The connection itself was refused (no or wrong token, too many clients).
+                    raise OrchestratorError(f"the orchestrator at {self.endpoint} {response.error}")
                 continue  # an answer to a request given up on earlier
             data = sock.recv(65536)
             if not data:
                 raise OSError("the orchestrator closed the connection")
             self._reader.feed(data)
+
+    def _refusal(self, sock: socket.socket) -> str:
+        """A refusal the orchestrator sent before closing (its error Response with id 0), if one
+        is still waiting in the reader or the socket: a send may fail before it is read."""
+        try:
+            sock.setblocking(False)
+            self._reader.feed(sock.recv(65536))
+        except OSError:
+            pass
+        while True:
+            try:
+                body = self._reader.next()
+            except FramingError:
+                return ""
+            if body is None:
+                return ""
+            response = pb.Response()
+            response.ParseFromString(body)
+            if response.id == 0 and response.error:
+                return response.error
 
     def _drop(self) -> None:
         if self._sock is not None:

@@ -3,7 +3,9 @@ and unix:///absolute/path."""
 from __future__ import annotations
 
 import socket
-from typing import Tuple, Union
+from typing import Optional, Tuple, Union
+
+from . import auth
 
 Address = Union[Tuple[str, int], str]
 
@@ -27,15 +29,22 @@ def parse(endpoint: str) -> Tuple[int, Address]:
     raise ValueError(f"{endpoint!r}: expected tcp://host:port or unix:///path")
 
 
-def connect(endpoint: str, timeout: float) -> socket.socket:
-    """A connected stream socket (blocking, TCP_NODELAY). Raises OSError when nobody listens."""
+def connect(endpoint: str, timeout: float, token: Optional[str] = None) -> socket.socket:
+    """A connected stream socket (blocking, TCP_NODELAY). Raises OSError when nobody listens.
+    On TCP, the fleet's token (`token`, else canfleet.auth.resolve(): CANFLEET_TOKEN_FILE or
+    CANFLEET_TOKEN) is sent first when there is one: an orchestrator or broker beyond loopback
+    lets in only clients that send it; one on loopback takes it or none."""
     family, address = parse(endpoint)
+    if family != socket.AF_UNIX and token is None:
+        token = auth.resolve()
     sock = socket.socket(family, socket.SOCK_STREAM)
     try:
         sock.settimeout(timeout)
         sock.connect(address)
         if family != socket.AF_UNIX:
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if token:
+                sock.sendall(auth.preamble(token))
         return sock
     except BaseException:
         sock.close()

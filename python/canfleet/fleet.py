@@ -416,9 +416,11 @@ class Fleet:
         socket_path = state / "broker.sock"
         listen = f"unix://{socket_path}" if len(str(socket_path)) < 100 else "tcp://127.0.0.1:0"
         ready = state / "ready"
+        ready.unlink(missing_ok=True)  # a state folder used again: the last run's "state ready"
         log_path = state / "orchestrator.log"
         args = [str(binaries / "canfleet"), "up", str(topology.resolve()), "--ready-file", str(ready),
                 "--control", "tcp://127.0.0.1:0", "--listen", listen, "--state-dir", str(state / "nodes"),
+                "--capture-dir", str(state / "captures"),
                 "--time", time, "--log-level", log_level]
         if time == "virtual":
             args.append("--driven")
@@ -584,17 +586,17 @@ class Fleet:
         self._call(pb.Request(nmt=pb.NmtCommand(action=value, node=node or "")))  # type: ignore[arg-type]
 
     def capture(self, bus: str, path: Optional[Union[str, Path]] = None, format: str = "pcap") -> Capture:
-        """Starts a capture of `bus` (pcap, LINKTYPE 227, or "candump"), written by the orchestrator;
-        default path: captures/<bus>-<n>.<ext> in the state folder."""
+        """Starts a capture of `bus` (pcap, LINKTYPE 227, or "candump"), written by the orchestrator
+        to a new file inside the fleet's folders: `path` relative (default <bus>-<n>.<ext>) goes to
+        its capture folder (<state>/captures, or `canfleet up --capture-dir`); an absolute `path`
+        must be inside that or the state folder (orchestrator/fleet/capture_path.hpp). The
+        Capture's `path` is where the file is."""
         if format not in ("pcap", "candump"):
             raise ValueError(f"capture format {format!r}: pcap or candump")
         if path is None:
-            base = self.state_dir or Path(tempfile.gettempdir())
-            folder = base / "captures"
-            folder.mkdir(parents=True, exist_ok=True)
-            path = folder / f"{bus}-{len(self.captures) + 1}.{'pcap' if format == 'pcap' else 'log'}"
+            path = f"{bus}-{os.getpid()}-{len(self.captures) + 1}.{'pcap' if format == 'pcap' else 'log'}"
         started = self._call(pb.Request(capture_start=pb.CaptureStart(
-            bus=bus, path=str(Path(path).resolve()), format=format))).capture
+            bus=bus, path=str(path), format=format))).capture
         capture = Capture(self, started.capture_id, bus, Path(started.path))
         self.captures.append(capture)
         return capture

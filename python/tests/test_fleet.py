@@ -96,6 +96,22 @@ def test_a_capture_records_the_bus(fleet: Fleet) -> None:
     assert fleet.capture("can0").path.suffix == ".pcap"
 
 
+def test_a_capture_outside_the_fleets_folders_is_refused(fleet: Fleet, tmp_path: Path) -> None:
+    # Issue 32: anyone who may use the control API could otherwise have the orchestrator write (or
+    # truncate) any file its user can.
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    with pytest.raises(canfleet.OrchestratorError, match="writes captures only inside"):
+        fleet.capture("can0", victim)
+    with pytest.raises(canfleet.OrchestratorError, match="writes captures only inside"):
+        fleet.capture("can0", "../../../elsewhere.log")
+    assert victim.read_text() == "keep me"
+    existing = fleet.capture("can0", "once.log", format="candump")
+    existing.stop()
+    with pytest.raises(canfleet.OrchestratorError, match="exists: a capture never replaces a file"):
+        fleet.capture("can0", "once.log", format="candump")
+
+
 def test_refusals_carry_the_orchestrators_message(fleet: Fleet) -> None:
     with pytest.raises(canfleet.OrchestratorError, match="no node called 'nobody'"):
         fleet.inject("bus-off", node="nobody")

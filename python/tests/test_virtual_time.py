@@ -124,7 +124,7 @@ def _scripted_run(folder: Path, load: bool) -> bytes:
         hog.start()
     try:
         with Fleet.up(PAIR, time="virtual", seed=7, state_dir=folder) as fleet:
-            capture = fleet.capture("can0", folder / "can0.log", format="candump")
+            capture = fleet.capture("can0", "can0.log", format="candump")  # in <folder>/captures
             net = canopen.Network()
             net.connect(interface="canfleet", channel="can0", fleet=fleet, name="python-canopen")
             io = canopen.RemoteNode(21, str(CONFORMANCE_IO_EDS))
@@ -140,7 +140,7 @@ def _scripted_run(folder: Path, load: bool) -> bytes:
             fleet.run(0.5)
             capture.stop()
             net.disconnect()
-            return (folder / "can0.log").read_bytes()
+            return capture.path.read_bytes()
     finally:
         for hog in hogs:
             hog.kill()

@@ -166,6 +166,10 @@ trap teardown EXIT
 trap 'exit 130' INT TERM
 
 # ---- static: the compose file parses in every tool that is here ---------------------------------
+# The fleet's token file the compose file's secret names (scripts/docker-fleet.sh makes it).
+fleet network >/dev/null 2>&1 || true
+[ -s "${CANFLEET_TOKEN_HOST_FILE:-$repo/build-docker/secrets/canfleet-token}" ] ||
+  fail "scripts/docker-fleet.sh did not make the fleet's token file"
 if command -v docker-compose >/dev/null; then
   docker-compose -f docker/compose.yaml config -q || fail "docker-compose 1.x refuses docker/compose.yaml"
   pass "docker-compose $(docker-compose version --short) accepts docker/compose.yaml"
@@ -243,6 +247,26 @@ done
 expect_eq "quad-6 1400h sub 1 (RPDO1 COB-ID, set by the orchestrator)" "$(sdo_u32 quad-6 0x1400 1)" 0x185
 expect_eq "quad-5 1016h sub 1 (consumer of quad-7, 1500 ms)" "$(sdo_u32 quad-5 0x1016 1)" 0x000705DC
 pass "the orchestrator configured the external nodes (quad-6 1400h.1 = 185h, quad-5 1016h.1 = 000705DCh)"
+
+# The fleet's token (docs/security.md): the control API listens on every address of its container,
+# so it lets in only clients with the Docker secret's token. The nodes joined with it (above).
+if [ -x build/bin/canfleet ]; then
+  out=$(env -u CANFLEET_TOKEN -u CANFLEET_TOKEN_FILE build/bin/canfleet --control "tcp://127.0.0.1:$CANFLEET_CONTROL_PORT" status 2>&1) &&
+    fail "the compose fleet's control API answered a client without the token"
+  printf '%s' "$out" | grep -q "refused: no token" || fail "no token: expected a refusal naming it, got: $out"
+  wrong=$(mktemp)
+  echo "not-the-fleet-token-0123456789" >"$wrong"
+  out=$(CANFLEET_TOKEN_FILE="$wrong" build/bin/canfleet --control "tcp://127.0.0.1:$CANFLEET_CONTROL_PORT" nmt stop 2>&1) &&
+    fail "the compose fleet's control API took a wrong token"
+  rm -f "$wrong"
+  printf '%s' "$out" | grep -q "refused: wrong token" || fail "wrong token: expected a refusal naming it, got: $out"
+  [ "$(node_get quad-5 nmt_state)" = operational ] || fail "the refused nmt stop reached the nodes"
+  pass "the fleet's token from a Docker secret: the nodes joined with it; the control API refuses a client without it ('refused: no token') and with a wrong one ('refused: wrong token'; the nmt stop did nothing)"
+else
+  unchecked+=("the control API's refusals of clients without the token (needs build/bin/canfleet on the host)")
+fi
+grep -q "canfleet_token" <(docker inspect -f '{{range .Mounts}}{{.Destination}} {{end}}' "$(fleet compose ps -q orchestrator)") ||
+  fail "the orchestrator's container has no /run/secrets/canfleet_token"
 net=$(fleet network)
 
 # ---- 2. DDS telemetry across containers -----------------------------------------------------------

@@ -20,9 +20,13 @@
 #     and operational through each bus's control API (published in host mode); the orchestrator
 #     configured the nodes whose node-ID and name come from their task slot (1016h, 1017h read back)
 #  2. socketcand of can0 on its published port (hi, open, a frame in raw mode); can1's control API port
+#  2b. the fleet's token: a Docker secret of the orchestrator and node services; a CLI without it
+#     is refused by the published control API
 #  3. `docker service scale` of can0's node service to 20: 30 nodes operational
 #  4. DDS across the overlay with unicast discovery only: canfleet-top --once in a container at a
 #     monitor slot on the overlay network shows all 30 nodes of both buses operational
+#  4b. canfleet web at a monitor slot (`scripts/docker-swarm.sh web`), published on loopback: its
+#     /api/state shows the 30 nodes of both buses operational, the page is served, actions are refused
 #  5. `docker kill` of node 3's task on can0: its consumer can0-node-4 reports the heartbeat loss
 #     (EMCY 8130h, control API and canfleet-watch on the overlay) and goes pre-operational; swarm
 #     replaces the task (same slot, so same node-ID and name), the orchestrator configures it again
@@ -150,11 +154,11 @@ if ! docker image inspect "$CANFLEET_IMAGE" >/dev/null 2>&1; then
 fi
 
 # ---- ports, subnet and shard file of this run ------------------------------------------------------
-# Six free host ports (a running demo stack or compose fleet is not disturbed) and an overlay
+# Seven free host ports (the last for the browser view) (a running demo stack or compose fleet is not disturbed) and an overlay
 # subnet that overlaps no existing network.
-read -r p1 p2 p3 p4 p5 p6 < <(python3 -c '
+read -r p1 p2 p3 p4 p5 p6 p7 < <(python3 -c '
 import socket
-socks = [socket.socket() for _ in range(6)]
+socks = [socket.socket() for _ in range(7)]
 for s in socks: s.bind(("127.0.0.1", 0))
 print(*[s.getsockname()[1] for s in socks])')
 used_subnets=$(docker network ls -q | xargs -r docker network inspect -f '{{range .IPAM.Config}}{{.Subnet}} {{end}}' 2>/dev/null || true)
@@ -285,6 +289,20 @@ python3 -c 'import socket, sys; socket.create_connection(("127.0.0.1", int(sys.a
   fail "can1's control API is not published on 127.0.0.1:$p5"
 pass "published in host mode: socketcand of can0 on 127.0.0.1:$p3 (hi, open can0, rawmode, $sc_out); can1's control API accepts on 127.0.0.1:$p5"
 
+# ---- 2b. the fleet's token: a Docker secret of the stack ------------------------------------------
+docker service inspect -f '{{range .Spec.TaskTemplate.ContainerSpec.Secrets}}{{.File.Name}} {{end}}' "${stack}_can0-orchestrator" |
+  grep -q canfleet_token || fail "can0's orchestrator service has no canfleet_token secret"
+docker service inspect -f '{{range .Spec.TaskTemplate.ContainerSpec.Secrets}}{{.File.Name}} {{end}}' "${stack}_can0-nodes" |
+  grep -q canfleet_token || fail "can0's node service has no canfleet_token secret"
+if [ -x build/bin/canfleet ]; then
+  out=$(env -u CANFLEET_TOKEN -u CANFLEET_TOKEN_FILE build/bin/canfleet --control "tcp://127.0.0.1:$p2" status 2>&1) &&
+    fail "can0's published control API answered a client without the token"
+  printf '%s' "$out" | grep -q "refused: no token" || fail "no token: expected a refusal naming it, got: $out"
+  pass "the fleet's token is the stack's Docker secret (orchestrator and node services); the nodes joined with it; can0's control API on 127.0.0.1:$p2 refuses a client without it"
+else
+  pass "the fleet's token is the stack's Docker secret (orchestrator and node services); the nodes joined with it"
+fi
+
 # ---- 3. scale can0 to 20 nodes -------------------------------------------------------------------
 t=$(date +%s)
 swarm scale can0 20 --no-wait || fail "docker service scale of can0 failed"
@@ -317,6 +335,42 @@ ctl_out=$(docker run --rm --network "${stack}_fleet" -e CANFLEET_DDS_CONFIG= \
 printf '%s\n' "$ctl_out" | grep -q ' 0 nodes on 0 buses' ||
   { printf '%s\n' "$ctl_out" | head -5 >&2; fail "a monitor outside the monitor slots saw writers: discovery is not what the stack says"; }
 pass "DDS across the overlay, unicast discovery: canfleet-top --once at a monitor slot shows all 30 nodes operational (can0 20, can1 10); the same configuration at an address that is no slot sees 0 nodes ($(elapsed "$t"))"
+
+# ---- 4b. the browser view at a monitor slot ------------------------------------------------------
+t=$(date +%s)
+swarm web --port "$p7" >"$work/web.log" 2>&1 &
+web_pid=$!
+web_state() { # prints "can0 N can1 M" operational in /api/state
+  python3 - "$p7" <<'PY'
+import json, sys, urllib.request
+state = json.load(urllib.request.urlopen("http://127.0.0.1:%s/api/state" % sys.argv[1], timeout=5))
+count = {"can0": 0, "can1": 0}
+for n in state["nodes"]:
+    if n.get("nmt") == "operational" and n.get("bus") in count:
+        count[n["bus"]] += 1
+print("can0", count["can0"], "can1", count["can1"])
+PY
+}
+web_all() { [ "$(web_state 2>/dev/null)" = "can0 20 can1 10" ]; }
+wait_for 90 "canfleet web at a monitor slot: /api/state shows can0 20 and can1 10 operational (last: $(web_state 2>&1 | tail -1))" web_all
+page=$(python3 -c 'import sys, urllib.request; print(urllib.request.urlopen("http://127.0.0.1:%s/" % sys.argv[1], timeout=5).read().decode())' "$p7")
+printf '%s' "$page" | grep -q '<title>canfleet' || fail "canfleet web at a monitor slot did not serve its page"
+refused=$(python3 - "$p7" <<'PY'
+import sys, urllib.error, urllib.request
+req = urllib.request.Request("http://127.0.0.1:%s/api/action" % sys.argv[1], data=b'{"nmt":{"command":"stop"}}',
+                             headers={"Content-Type": "application/json"})
+try:
+    urllib.request.urlopen(req, timeout=5)
+    print("accepted")
+except urllib.error.HTTPError as e:
+    print(e.code)
+PY
+)
+[ "$refused" = 403 ] || fail "canfleet web at a monitor slot (read-only) answered an action with '$refused', not 403"
+docker rm -f "$(docker ps -q --filter "label=canfleet.stack=$stack" --filter ancestor="$CANFLEET_IMAGE" | head -1)" >/dev/null 2>&1 || true
+kill "$web_pid" 2>/dev/null || true
+wait "$web_pid" 2>/dev/null || true
+pass "canfleet web at a monitor slot (scripts/docker-swarm.sh web, published on 127.0.0.1:$p7): /api/state shows can0 20 and can1 10 operational from DDS across the overlay, the page is served, an action is refused (403, read-only) ($(elapsed "$t"))"
 
 # ---- 5. kill a node task: its consumer's heartbeat-loss EMCY and its return ------------------------
 watch_log="$work/watch.log"

@@ -216,6 +216,53 @@ TEST_F(Transport, RefusalIsLoggedOnBothSides) {
   EXPECT_FALSE(a->Connected());
 }
 
+// The fleet's token on a broker beyond loopback (bus/wire/auth_gate.hpp): the listener is
+// 0.0.0.0, reached here through 127.0.0.1.
+constexpr const char* kFleetToken = "fleet-token-0123456789abcdef";
+
+TEST_F(Transport, BeyondLoopbackANodeWithoutTheTokenIsRefusedAndTold) {
+  LogCapture log;
+  transport::BrokerServer server(io_, broker_, {.token = kFleetToken});
+  const auto bound = server.Listen(wire::Endpoint::Parse("tcp://0.0.0.0:0"));
+  BrokerClientOptions options;
+  options.endpoint = "tcp://127.0.0.1:" + std::to_string(bound.port);
+  options.node_name = "intruder";
+  auto a = std::make_unique<BrokerClientPort>(io_, options);
+  std::vector<std::string> connection;
+  a->OnConnection(
+      [&](bool up, const std::string& detail) { connection.push_back((up ? "up " : "down ") + detail); });
+  ASSERT_TRUE(RunUntil([&] { return !connection.empty(); }));
+  EXPECT_NE(connection[0].find("down refused: no token"), std::string::npos) << connection[0];
+  EXPECT_EQ(server.SessionCount(), 0u);  // no session was ever made for it
+  EXPECT_GE(server.Stats().refused_connections, 1u);
+  EXPECT_NE(log.Text().find("refused tcp 127.0.0.1:"), std::string::npos) << log.Text();
+}
+
+TEST_F(Transport, BeyondLoopbackAWrongTokenIsRefusedAndTheRightOneAttaches) {
+  transport::BrokerServer server(io_, broker_, {.token = kFleetToken});
+  const auto bound = server.Listen(wire::Endpoint::Parse("tcp://0.0.0.0:0"));
+  BrokerClientOptions options;
+  options.endpoint = "tcp://127.0.0.1:" + std::to_string(bound.port);
+  options.node_name = "wrong";
+  options.token = "fleet-token-0123456789abcdeX";
+  auto wrong = std::make_unique<BrokerClientPort>(io_, options);
+  std::vector<std::string> connection;
+  wrong->OnConnection(
+      [&](bool up, const std::string& detail) { connection.push_back((up ? "up " : "down ") + detail); });
+  ASSERT_TRUE(RunUntil([&] { return !connection.empty(); }));
+  EXPECT_EQ(connection[0], "down refused: wrong token");
+  wrong.reset();
+  options.node_name = "right";
+  options.token = kFleetToken;
+  auto right = std::make_unique<BrokerClientPort>(io_, options);
+  ASSERT_TRUE(RunUntil([&] { return right->Connected(); }));
+}
+
+TEST_F(Transport, BeyondLoopbackWithoutATokenTheBrokerDoesNotListen) {
+  transport::BrokerServer server(io_, broker_);
+  EXPECT_THROW(server.Listen(wire::Endpoint::Parse("tcp://0.0.0.0:0")), std::runtime_error);
+}
+
 TEST_F(Transport, ConnectionWithoutHelloIsClosedAfterTheDeadline) {
   transport::BrokerServer server(io_, broker_, {.hello_timeout = 200ms});
   const std::string ep = Listen(server);

@@ -21,9 +21,10 @@ int RunStart(const GlobalOptions& global, const StartArgs& a) {
   control::Request request;
   auto* body = request.mutable_capture_start();
   body->set_bus(a.bus);
-  // The orchestrator resolves relative paths against its own working directory; the user means
-  // theirs.
-  body->set_path(std::filesystem::absolute(a.file).lexically_normal().string());
+  // Sent as given: the orchestrator puts a relative file in the fleet's capture folder and writes
+  // only inside the fleet's folders (orchestrator/fleet/capture_path.hpp); it answers with the
+  // absolute path.
+  body->set_path(a.file);
   body->set_format(a.format);
   const control::Response response = Call(global, request);
   if (a.json)
@@ -43,7 +44,11 @@ void AddCaptureCommands(CLI::App& app, Cli& cli) {
   auto a = std::make_shared<StartArgs>();
   CLI::App* start = capture->add_subcommand("start", "Start recording; prints the capture's id and file");
   start->add_option("--bus", a->bus, "The bus to record")->required();
-  start->add_option("--file", a->file, "Where to write (relative to the current folder)")->required();
+  start
+      ->add_option("--file", a->file,
+                   "The file to write: relative to the fleet's capture folder (canfleet up --capture-dir, "
+                   "default <state folder>/captures), or an absolute path inside it or the state folder")
+      ->required();
   start->add_option("--format", a->format, "pcap (LINKTYPE_CAN_SOCKETCAN) or candump (log format)")
       ->check(CLI::IsMember({"pcap", "candump"}));
   start->add_flag("--json", a->json, "Print the CaptureStarted message as JSON");

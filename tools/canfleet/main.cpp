@@ -1,5 +1,6 @@
 // canfleet: the command line of the fleet (tools/canfleet/README.md). `up` runs the orchestrator;
 // every other command talks to a running one over the control API. One file per command group.
+#include <cstdlib>
 #include <iostream>
 
 #include "orchestrator/control/control_protocol.hpp"
@@ -17,6 +18,13 @@ int main(int argc, char** argv) {
       app.add_option("--control", cli.global.control, "The orchestrator's control API (tcp://HOST:PORT)")
           ->envname("CANFLEET_CONTROL")
           ->capture_default_str();
+  std::string token_file;
+  app.add_option(
+         "--token-file", token_file,
+         "File holding the fleet's token: sent to an orchestrator beyond loopback (clients), required "
+         "of clients when listening beyond loopback (up). Default: CANFLEET_TOKEN_FILE, else "
+         "CANFLEET_TOKEN")
+      ->check(CLI::ExistingFile);
   std::string timeout = "30s";
   app.add_option("--timeout", timeout, "How long to wait for the orchestrator's answer")
       ->check(DurationValidator())
@@ -37,6 +45,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     cli.global.control_given = control->count() > 0;
     cli.global.timeout = std::chrono::milliseconds(DurationMs(timeout));
+    // One place for every client and server in this process (and the processes it starts).
+    if (!token_file.empty()) ::setenv("CANFLEET_TOKEN_FILE", token_file.c_str(), 1);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }

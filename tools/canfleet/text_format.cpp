@@ -54,6 +54,12 @@ std::string Process(const control::NodeStatus& node) {
 
 /// The CONTROLLER column: the state, and the port's bit rate when it is not its bus's
 /// ("error-passive @250k": a node at the wrong rate sees no traffic).
+/// The NMT state, marked when it is old news (no heartbeat for three of the node's periods).
+std::string NmtText(const std::string& state, bool stale) {
+  if (state.empty()) return "-";
+  return stale ? state + " (stale)" : state;
+}
+
 std::string ControllerText(const control::PortStatus& port) {
   std::string text = port.controller().empty() ? "-" : port.controller();
   if (port.bitrate() != 0) text += " @" + FormatBitrate(port.bitrate());
@@ -180,7 +186,7 @@ std::string FormatStatus(const control::Status& status) {
           nodes.AddRow({first ? n.name() : "  CAN" + std::to_string(p + 1), first ? n.device() : "",
                         std::to_string(port.node_id()), port.bus(), first ? Process(n) : "",
                         first && n.pid() != 0 ? std::to_string(n.pid()) : (first ? "-" : ""),
-                        port.nmt_state().empty() ? "-" : port.nmt_state(), ControllerText(port),
+                        NmtText(port.nmt_state(), port.nmt_stale()), ControllerText(port),
                         std::to_string(port.tec()), std::to_string(port.rec()),
                         FormatSeconds(port.heartbeat_age_s()), LastEmcy(port)});
         }
@@ -188,7 +194,7 @@ std::string FormatStatus(const control::Status& status) {
       }
       nodes.AddRow(
           {n.name(), n.device(), Join(n.node_ids()), Join(n.buses()), Process(n),
-           n.pid() != 0 ? std::to_string(n.pid()) : "-", n.nmt_state().empty() ? "-" : n.nmt_state(),
+           n.pid() != 0 ? std::to_string(n.pid()) : "-", NmtText(n.nmt_state(), n.nmt_stale()),
            n.ports_size() == 1 ? ControllerText(n.ports(0)) : (n.controller().empty() ? "-" : n.controller()),
            std::to_string(n.tec()), std::to_string(n.rec()), FormatSeconds(n.heartbeat_age_s()),
            LastEmcy(n)});

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include "bus/wire/auth_token.hpp"
 #include "telemetry/cli_options.hpp"
 
 #include "orchestrator/fleet/fleet_time.hpp"
@@ -27,6 +28,7 @@ struct UpArgs {
   std::string time;       ///< "" = the topology's
   std::string speed;      ///< "" = the topology's
   std::string state_dir;  ///< "" = the topology's state_root
+  std::string capture_dir;
   std::optional<std::uint64_t> seed;
   telemetry::DdsOptions dds;
 };
@@ -37,6 +39,12 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   if (global.control_given) options.control = global.control;
   if (!args.listen.empty()) options.listen = args.listen;
   options.socketcand_bind = args.socketcand_bind;
+  try {
+    options.token = wire::ResolveToken().value_or("");  // --token-file sets CANFLEET_TOKEN_FILE
+  } catch (const std::runtime_error& e) {
+    std::cerr << "canfleet up: " << e.what() << '\n';
+    return kExitUsage;
+  }
   options.node_binary = args.node_binary;
   options.ready_file = args.ready_file;
   options.log_level = args.log_level;
@@ -47,6 +55,7 @@ int RunUp(const GlobalOptions& global, const UpArgs& args) {
   options.dds = args.dds;
   options.time.mode = args.time;
   if (!args.state_dir.empty()) options.state_root = args.state_dir;
+  options.capture_dir = args.capture_dir;
   options.seed = args.seed;
   if (!args.speed.empty()) {
     try {
@@ -130,6 +139,10 @@ void AddUpCommands(CLI::App& app, Cli& cli) {
   up->add_option("--state-dir", args->state_dir,
                  "Folder for the nodes' state and logs, instead of the topology's state_root (a private "
                  "fleet: tests, python/canfleet)");
+  up->add_option("--capture-dir", args->capture_dir,
+                 "Folder for captures asked for over the control API (`canfleet capture start`): a relative "
+                 "--file goes there; the orchestrator writes captures only there and in the state folder "
+                 "(default: <state folder>/captures)");
   up->add_option("--seed", args->seed,
                  "Seed of the random draws of faults that give none (overrides the topology's time.seed)");
   up->add_flag("!--no-telemetry", args->telemetry, "Do not publish BusStats and FaultEvents over DDS");

@@ -3,6 +3,7 @@
 // connection). The server runs on its own io thread, as in the orchestrator.
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <stdlib.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <mutex>
 #include <thread>
 
+#include "bus/wire/auth_token.hpp"
 #include "bus/wire/varint.hpp"
 #include "orchestrator/control/control_client.hpp"
 #include "orchestrator/control/control_server.hpp"
@@ -60,9 +62,11 @@ Request StatusRequest() {
 
 class ControlTransport : public ::testing::Test {
  protected:
-  void Start(ControlServerOptions options = {}) {
+  /// `listen`: 0.0.0.0 is beyond loopback (a token is required); the clients still connect
+  /// through 127.0.0.1, which reaches that listener too.
+  void Start(ControlServerOptions options = {}, const std::string& listen = "tcp://127.0.0.1:0") {
     server_ = std::make_unique<ControlServer>(io_, handler_, options);
-    const auto ep = server_->Listen("tcp://127.0.0.1:0");
+    const auto ep = server_->Listen(listen);
     endpoint_ = "tcp://127.0.0.1:" + std::to_string(ep.port());
     thread_ = std::thread([this] { io_.run(); });
   }
@@ -482,6 +486,151 @@ TEST(DelimitedReader, MessagesSplitAcrossReadsAndManyInOneRead) {
   }
   EXPECT_EQ(ids, (std::vector<std::uint64_t>{1, 2, 3}));
   EXPECT_EQ(reader.Buffered(), 0u);
+}
+
+// ---- the fleet's token (bus/wire/auth_gate.hpp) -------------------------------------------------
+
+constexpr const char* kToken = "fleet-token-0123456789abcdef";
+
+/// Sets CANFLEET_TOKEN for the ControlClients of one test (they read the environment).
+class ClientToken {
+ public:
+  explicit ClientToken(const char* token) {
+    ::unsetenv("CANFLEET_TOKEN_FILE");
+    if (token)
+      ::setenv("CANFLEET_TOKEN", token, 1);
+    else
+      ::unsetenv("CANFLEET_TOKEN");
+  }
+  ~ClientToken() { ::unsetenv("CANFLEET_TOKEN"); }
+};
+
+void AnswerStatus(FakeHandler& handler) {
+  handler.on_request = [](const Request& request, std::shared_ptr<Responder> responder) {
+    responder->Send(StatusResponse(request, "ok"));
+  };
+}
+
+std::string CallError(const std::string& endpoint) {
+  try {
+    ControlClient client(endpoint);
+    client.Call(StatusRequest(), 5s);
+  } catch (const ControlError& e) {
+    return e.what();
+  }
+  return "answered";
+}
+
+TEST_F(ControlTransport, BeyondLoopbackWithoutATokenTheServerDoesNotStart) {
+  server_ = std::make_unique<ControlServer>(io_, handler_, ControlServerOptions{});
+  try {
+    server_->Listen("tcp://0.0.0.0:0");
+    FAIL() << "listened beyond loopback without a token";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("needs the fleet's token"), std::string::npos) << e.what();
+  }
+  server_.reset();
+}
+
+TEST_F(ControlTransport, BeyondLoopbackAClientWithoutTheTokenIsRefusedAndTold) {
+  AnswerStatus(handler_);
+  Start({.token = kToken}, "tcp://0.0.0.0:0");
+  ClientToken none(nullptr);
+  const auto error = CallError(endpoint_);
+  EXPECT_NE(error.find("refused: no token"), std::string::npos) << error;
+  EXPECT_EQ(handler_.calls, 0);
+  EXPECT_TRUE(WaitUntil([&] { return OnIo([&] { return server_->Stats().refused; }) == 1; }));
+  EXPECT_EQ(OnIo([&] { return server_->SessionCount(); }), 0u);
+}
+
+TEST_F(ControlTransport, BeyondLoopbackAWrongTokenIsRefused) {
+  AnswerStatus(handler_);
+  Start({.token = kToken}, "tcp://0.0.0.0:0");
+  ClientToken wrong("fleet-token-0123456789abcdeX");
+  const auto error = CallError(endpoint_);
+  EXPECT_NE(error.find("refused: wrong token"), std::string::npos) << error;
+  EXPECT_EQ(handler_.calls, 0);
+}
+
+TEST_F(ControlTransport, BeyondLoopbackTheRightTokenIsLetIn) {
+  AnswerStatus(handler_);
+  Start({.token = kToken}, "tcp://0.0.0.0:0");
+  ClientToken right(kToken);
+  EXPECT_EQ(CallError(endpoint_), "answered");
+  EXPECT_EQ(handler_.calls, 1);
+}
+
+TEST_F(ControlTransport, OnLoopbackNoTokenIsNeededAndOneIsTaken) {
+  AnswerStatus(handler_);
+  Start();
+  {
+    ClientToken none(nullptr);
+    EXPECT_EQ(CallError(endpoint_), "answered");
+  }
+  ClientToken some(kToken);  // a client with a token talks to a server that asks for none
+  EXPECT_EQ(CallError(endpoint_), "answered");
+  EXPECT_EQ(handler_.calls, 2);
+}
+
+TEST_F(ControlTransport, OnLoopbackAServerWithATokenStillRefusesAWrongOne) {
+  AnswerStatus(handler_);
+  Start({.token = kToken});
+  ClientToken wrong("fleet-token-0123456789abcdeX");
+  EXPECT_NE(CallError(endpoint_).find("wrong token"), std::string::npos);
+}
+
+TEST_F(ControlTransport, APreambleInPiecesIsReadWhole) {
+  AnswerStatus(handler_);
+  Start({.token = kToken}, "tcp://0.0.0.0:0");
+  RawClient raw(PortOf(endpoint_));
+  const std::string preamble = wire::EncodeAuthPreamble(kToken);
+  raw.Send(preamble.substr(0, 3));
+  std::this_thread::sleep_for(20ms);  // not a timing assertion: only makes the pieces arrive apart
+  raw.Send(preamble.substr(3, 10));
+  std::this_thread::sleep_for(20ms);
+  std::string request;
+  ASSERT_TRUE(AppendDelimited(
+      [] {
+        Request r = StatusRequest();
+        r.set_id(7);
+        return r;
+      }(),
+      request));
+  raw.Send(preamble.substr(13) + request);
+  ASSERT_TRUE(WaitUntil([&] { return handler_.calls == 1; }));
+}
+
+TEST_F(ControlTransport, AClientThatSaysNothingIsClosedAfterTheHandshakeTimeout) {
+  Start({.token = kToken, .handshake_timeout = 100ms}, "tcp://0.0.0.0:0");
+  RawClient raw(PortOf(endpoint_));
+  const auto got = raw.ReadUntilClosed();
+  ASSERT_TRUE(got.has_value()) << "still open";
+  const auto responses = Responses(*got);
+  ASSERT_EQ(responses.size(), 1u);
+  EXPECT_NE(responses[0].error().find("nothing received within 100 ms"), std::string::npos);
+  EXPECT_EQ(OnIo([&] { return server_->GateStats().timed_out; }), 1u);
+}
+
+TEST_F(ControlTransport, ConnectionsWaitingAtTheGateAreBounded) {
+  Start({.token = kToken, .max_pending = 2}, "tcp://0.0.0.0:0");
+  RawClient a(PortOf(endpoint_)), b(PortOf(endpoint_));
+  ASSERT_TRUE(WaitUntil([&] { return OnIo([&] { return server_->GateStats().pending; }) == 2; }));
+  RawClient c(PortOf(endpoint_));
+  const auto got = c.ReadUntilClosed();
+  ASSERT_TRUE(got.has_value()) << "a third silent connection was kept";
+  EXPECT_EQ(OnIo([&] { return server_->GateStats().pending; }), 2u);
+}
+
+TEST_F(ControlTransport, SessionsAreBoundedAndTheNextClientIsTold) {
+  AnswerStatus(handler_);
+  Start({.max_sessions = 2});
+  ClientToken none(nullptr);
+  ControlClient first(endpoint_), second(endpoint_);
+  first.Call(StatusRequest(), 5s);
+  second.Call(StatusRequest(), 5s);
+  const auto error = CallError(endpoint_);
+  EXPECT_NE(error.find("too many connections"), std::string::npos) << error;
+  EXPECT_EQ(OnIo([&] { return server_->SessionCount(); }), 2u);
 }
 
 }  // namespace

@@ -30,6 +30,29 @@ TEST(NodeTracker, BootUpHeartbeatAndEmcyAreRecorded) {
   EXPECT_EQ(tracker.Find("can1", 5), nullptr);  // buses are separate
 }
 
+TEST(NodeTracker, AStateNotHeardForThreeHeartbeatPeriodsIsStale) {
+  // Issue 32: status never shows a state it has not seen recently (a babbling idiot's flood, a
+  // partition). On simulated time: heartbeats every 500 ms, then none.
+  using std::chrono::milliseconds;
+  NodeTracker tracker;
+  const TimePoint t0{std::chrono::seconds(1)};
+  tracker.Observe("can0", test::Frame("705#00"), t0);
+  EXPECT_FALSE(tracker.Find("can0", 5)->Stale(t0 + std::chrono::hours(1))) << "no period seen: never stale";
+  tracker.Observe("can0", test::Frame("705#7F"), t0 + milliseconds(500));
+  tracker.Observe("can0", test::Frame("705#05"), t0 + milliseconds(1000));
+  const auto& live = *tracker.Find("can0", 5);
+  ASSERT_TRUE(live.heartbeat_period.has_value());
+  EXPECT_EQ(*live.heartbeat_period, milliseconds(500));
+  EXPECT_FALSE(live.Stale(t0 + milliseconds(2500)));
+  EXPECT_TRUE(live.Stale(t0 + milliseconds(2501)));
+  tracker.Observe("can0", test::Frame("705#05"), t0 + milliseconds(4000));  // heard again
+  EXPECT_FALSE(tracker.Find("can0", 5)->Stale(t0 + milliseconds(4001)));
+  EXPECT_EQ(*tracker.Find("can0", 5)->heartbeat_period, milliseconds(500)) << "the gap does not stretch it";
+  EXPECT_TRUE(tracker.Find("can0", 5)->Stale(t0 + milliseconds(5501)));
+  tracker.Observe("can0", test::Frame("705#00"), t0 + milliseconds(4100));  // a boot-up starts over
+  EXPECT_FALSE(tracker.Find("can0", 5)->heartbeat_period.has_value());
+}
+
 TEST(NodeTracker, OtherFramesAndBadLengthsAreIgnored) {
   NodeTracker tracker;
   tracker.Observe("can0", test::Frame("705#0500"), TimePoint{});  // DLC 2: not a heartbeat

@@ -24,12 +24,5 @@ TEST(WebListen, LoopbackAddresses) {
   EXPECT_FALSE(IsLoopback("not an address"));
 }
 
-TEST(WebToken, Random128BitsInHex) {
-  const std::string a = MakeToken(), b = MakeToken();
-  EXPECT_EQ(a.size(), 32u);
-  EXPECT_NE(a, b);
-  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos);
-}
-
 }  // namespace
 }  // namespace canfleet::web

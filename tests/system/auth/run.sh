@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The fleet's token, end to end (tests/system/auth): a real orchestrator listening beyond loopback,
+# real node processes, the CLI, the Python client and python-can, each with no token, a wrong one
+# and the right one; garbage and silent clients on the ports.
+#
+# Usage: tests/system/auth/run.sh [BUILD_DIR] [PYTEST_ARGS...]   (exit codes as python/run-tests.sh)
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+repo="$(cd "$here/../../.." && pwd)"
+# shellcheck source=scripts/python-suite.sh
+source "$repo/scripts/python-suite.sh"
+python_suite_setup "auth tests" "$@"
+cd "$here"
+export CANFLEET_BIN_DIR="$build/bin"
+export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-94}"  # this suite's own DDS domain
+exec "$python" -m pytest -p no:cacheprovider -rs "--junitxml=$build/auth-junit.xml" "${suite_args[@]}" .
