@@ -52,23 +52,9 @@ compose_tool() {
 compose_tool
 dc() { "${compose[@]}" -f "$compose_file" -p "$CANFLEET_PROJECT" "$@"; }
 
-# The fleet's token file: made once, random, readable only through a folder its owner alone may
-# enter (the file itself must be readable by the containers' user, which is not the host's).
-export CANFLEET_TOKEN_HOST_FILE="${CANFLEET_TOKEN_HOST_FILE:-$repo/build-docker/secrets/canfleet-token}"
-ensure_token() {
-  [ -s "$CANFLEET_TOKEN_HOST_FILE" ] && return 0
-  local dir tmp
-  dir=$(dirname "$CANFLEET_TOKEN_HOST_FILE")
-  mkdir -p "$dir"
-  chmod 700 "$dir"
-  tmp=$(mktemp "$dir/.token.XXXXXX")
-  od -An -N16 -tx1 /dev/urandom | tr -d ' \n' >"$tmp"
-  echo >>"$tmp"
-  chmod 644 "$tmp"
-  mv "$tmp" "$CANFLEET_TOKEN_HOST_FILE"
-  say "made the fleet's token: $CANFLEET_TOKEN_HOST_FILE"
-}
-ensure_token
+# shellcheck source=scripts/fleet-token.sh
+source "$repo/scripts/fleet-token.sh"
+ensure_fleet_token
 
 # The canfleet CLI talking to the fleet's control API.
 cli() {

@@ -53,21 +53,8 @@ net="${stack}_fleet"
 say() { echo "docker-swarm: $*"; }
 die() { echo "docker-swarm: ERROR: $1" >&2; exit "${2:-1}"; }
 
-# The fleet's token file (as scripts/docker-fleet.sh makes it).
-export CANFLEET_TOKEN_HOST_FILE="${CANFLEET_TOKEN_HOST_FILE:-$repo/build-docker/secrets/canfleet-token}"
-ensure_token() {
-  [ -s "$CANFLEET_TOKEN_HOST_FILE" ] && return 0
-  local dir tmp
-  dir=$(dirname "$CANFLEET_TOKEN_HOST_FILE")
-  mkdir -p "$dir"
-  chmod 700 "$dir"
-  tmp=$(mktemp "$dir/.token.XXXXXX")
-  od -An -N16 -tx1 /dev/urandom | tr -d ' \n' >"$tmp"
-  echo >>"$tmp"
-  chmod 644 "$tmp"
-  mv "$tmp" "$CANFLEET_TOKEN_HOST_FILE"
-  say "made the fleet's token: $CANFLEET_TOKEN_HOST_FILE"
-}
+# shellcheck source=scripts/fleet-token.sh
+source "$repo/scripts/fleet-token.sh"
 
 need_manager() {
   command -v docker >/dev/null || die "no 'docker' command" 3
@@ -170,7 +157,7 @@ wait_operational() {
 }
 
 render() { # SHARDS OUT
-  ensure_token
+  ensure_fleet_token
   python3 "$repo/docker/swarm/render.py" "$1" --out "$2" --stack "$stack" --network "$net" --subnet "$subnet" \
     --monitors "$monitors" --domain "$domain" --image "$image" --log-level "${CANFLEET_LOG_LEVEL:-info}" \
     --broker-base "${CANFLEET_SWARM_BROKER_BASE:-29600}" --control-base "${CANFLEET_SWARM_CONTROL_BASE:-29700}" \

@@ -33,3 +33,15 @@ python_suite_setup() {
   python="$(printf '%s\n' "$env_out" | tail -n 1)"
   export PYTHONDONTWRITEBYTECODE=1  # no __pycache__ in the source tree
 }
+
+# python_suite_pytest NAME DOMAIN [PYTEST_ARGS...]: runs pytest on the current folder against the
+# build's binaries (CANFLEET_BIN_DIR), on DDS domain DOMAIN unless CANFLEET_DDS_DOMAIN is set (each
+# suite has its own, so suites running side by side do not see each other's fleets), with the
+# suite's arguments; JUnit to BUILD/NAME-junit.xml. Replaces the shell.
+python_suite_pytest() {
+  local name=$1 domain=$2
+  shift 2
+  export CANFLEET_BIN_DIR="$build/bin"
+  export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-$domain}"
+  exec "$python" -m pytest -p no:cacheprovider -rs "$@" "--junitxml=$build/$name-junit.xml" "${suite_args[@]}" .
+}

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdio>
 
+#include "node/canopen/storage/le_writer.hpp"
+
 namespace canfleet::canopen {
 
 namespace {
@@ -25,21 +27,10 @@ constexpr std::array<std::uint32_t, 256> MakeCrcTable() {
 }
 constexpr auto kCrcTable = MakeCrcTable();
 
-void Put8(Bytes& out, std::uint8_t v) {
-  out.push_back(v);
-}
-void Put16(Bytes& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v));
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-}
-void Put32(Bytes& out, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i)
-    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-}
-void Patch32(Bytes& out, std::size_t at, std::uint32_t v) {
-  for (std::size_t i = 0; i < 4; ++i)
-    out[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
+using le::Patch32;
+using le::Put16;
+using le::Put32;
+using le::Put8;
 
 /// Bounds-checked little-endian reader: every Get fails (and keeps failing) instead of reading
 /// past the end, so a hostile length can never make the parser overrun.

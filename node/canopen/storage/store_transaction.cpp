@@ -4,6 +4,7 @@
 #include <array>
 
 #include "node/canopen/storage/atomic_file.hpp"
+#include "node/canopen/storage/le_writer.hpp"
 #include "node/canopen/storage/store_file.hpp"
 
 namespace canfleet::canopen {
@@ -17,14 +18,9 @@ constexpr std::size_t kHeaderSize = 16;
 /// A record names a handful of files; anything bigger is not one of ours.
 constexpr std::size_t kMaxRecordSize = 64 * 1024;
 
-void Put16(Bytes& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v));
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-}
-void Put32(Bytes& out, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i)
-    out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-}
+using le::Put16;
+using le::Put32;
+
 void PutShortString(Bytes& out, const std::string& s) {
   out.push_back(static_cast<std::uint8_t>(s.size()));
   out.insert(out.end(), s.begin(), s.end());

@@ -11,6 +11,4 @@ repo="$(cd "$here/../../.." && pwd)"
 source "$repo/scripts/python-suite.sh"
 python_suite_setup "auth tests" "$@"
 cd "$here"
-export CANFLEET_BIN_DIR="$build/bin"
-export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-94}"  # this suite's own DDS domain
-exec "$python" -m pytest -p no:cacheprovider -rs "--junitxml=$build/auth-junit.xml" "${suite_args[@]}" .
+python_suite_pytest auth 94

@@ -10,6 +10,4 @@ repo="$(cd "$here/../../.." && pwd)"
 source "$repo/scripts/python-suite.sh"
 python_suite_setup "chaos test" "$@"
 cd "$here"
-export CANFLEET_BIN_DIR="$build/bin"
-export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-95}"  # this suite's own DDS domain
-exec "$python" -m pytest -p no:cacheprovider -rs -s "--junitxml=$build/chaos-junit.xml" "${suite_args[@]}" .
+python_suite_pytest chaos 95 -s

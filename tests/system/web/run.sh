@@ -12,7 +12,5 @@ repo="$(cd "$here/../../.." && pwd)"
 source "$repo/scripts/python-suite.sh"
 python_suite_setup "web tests" "$@"
 cd "$here"
-export CANFLEET_BIN_DIR="$build/bin"
 export CANFLEET_WEB_SHOTS="$build/web-screenshots"
-export CANFLEET_DDS_DOMAIN="${CANFLEET_DDS_DOMAIN:-93}"
-exec "$python" -m pytest -p no:cacheprovider -rs "--junitxml=$build/web-junit.xml" "${suite_args[@]}" .
+python_suite_pytest web 93
