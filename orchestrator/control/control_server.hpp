@@ -27,6 +27,9 @@ struct ControlServerOptions {
   /// Bytes of responses a connection may have waiting for a client that does not read. Beyond
   /// it, FrameBatch responses (dumps) are dropped and counted; other responses are still queued.
   std::size_t max_backlog_bytes = std::size_t{16} << 20;
+  /// A connection whose backlog has stayed full this long (batches dropped all along) is closed
+  /// with the reason logged (transport/slow_reader.hpp).
+  std::chrono::milliseconds slow_reader_limit{30'000};
   /// When a connection is closed by the server (protocol error, Close), how long what is queued
   /// (an error response, a Shutdown's Done) may take to leave before the socket is closed anyway.
   std::chrono::milliseconds close_linger{1'000};
@@ -47,6 +50,7 @@ struct ControlServerStats {
   std::uint64_t protocol_errors = 0;  ///< connections closed for malformed or oversized messages
   std::uint64_t dropped_batches = 0;  ///< FrameBatch responses not queued for slow readers
   std::uint64_t refused = 0;          ///< connections refused: no or wrong token, too many
+  std::uint64_t slow_readers = 0;     ///< connections closed for not reading (slow_reader_limit)
 };
 
 /// Accepts connections and runs one session per connection, as asio's chat_server does: each

@@ -1,5 +1,6 @@
 #include "orchestrator/control/control_session.hpp"
 
+#include <asio/post.hpp>
 #include <asio/write.hpp>
 #include <exception>
 
@@ -58,7 +59,8 @@ ControlSession::ControlSession(asio::ip::tcp::socket socket, ControlHandler& han
       linger_(socket_.get_executor()),
       label_(std::move(label)),
       on_closed_(std::move(on_closed)),
-      reader_(options.max_message) {}
+      reader_(options.max_message),
+      slow_(options.slow_reader_limit) {}
 
 void ControlSession::Start() {
   responder_ = std::make_shared<SessionResponder>(weak_from_this());
@@ -114,9 +116,16 @@ void ControlSession::ProtocolError(const std::string& reason) {
 void ControlSession::Send(const Response& response) {
   if (closed_) return;
   if (response.has_frames() && filling_.size() >= options_.max_backlog_bytes) {
-    if (backlog_drops_ == 0) spdlog::warn("{}: client not reading; dropping frame batches", label_);
-    backlog_drops_++;
+    if (!slow_.Dropping()) spdlog::warn("{}: client not reading; dropping frame batches", label_);
     stats_->dropped_batches++;
+    if (slow_.Dropped(1, transport::SlowReader::Clock::now()) && !slow_close_posted_) {
+      // Not now: a dump's batches are sent from inside the broker's delivery.
+      slow_close_posted_ = true;
+      asio::post(socket_.get_executor(), [this, self = shared_from_this()] {
+        stats_->slow_readers++;
+        Close(slow_.Reason("frame batches"), false, spdlog::level::warn);
+      });
+    }
     return;
   }
   if (!AppendDelimited(response, filling_, options_.max_message)) {
@@ -188,11 +197,8 @@ void ControlSession::Flush() {
                         CloseSocket();
                         return;
                       }
-                      if (backlog_drops_ != 0) {
-                        spdlog::warn("{}: reading again; {} frame batches were dropped", label_,
-                                     backlog_drops_);
-                        backlog_drops_ = 0;
-                      }
+                      if (const auto lost = slow_.CaughtUp(); lost != 0)
+                        spdlog::warn("{}: reading again; {} frame batches were dropped", label_, lost);
                     });
 }
 

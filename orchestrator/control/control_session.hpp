@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "orchestrator/control/control_server.hpp"
+#include "orchestrator/transport/slow_reader.hpp"
 
 namespace canfleet::control::detail {
 
@@ -65,7 +66,9 @@ class ControlSession final : public std::enable_shared_from_this<ControlSession>
   std::string filling_;  ///< responses queued while a write is in flight
   std::string writing_;  ///< the write in flight
   bool write_in_flight_ = false;
-  std::uint64_t backlog_drops_ = 0;  ///< FrameBatch responses dropped in the current backlog episode
+  /// FrameBatch responses dropped for a full backlog; closed after slow_reader_limit.
+  transport::SlowReader slow_;
+  bool slow_close_posted_ = false;
 };
 
 }  // namespace canfleet::control::detail

@@ -42,7 +42,8 @@ Session::Session(std::shared_ptr<Context> context, asio::generic::stream_protoco
     : ctx_(std::move(context)),
       socket_(std::move(socket)),
       peer_(std::move(peer)),
-      name_("socketcand " + std::string(listener_bus) + " " + peer_) {
+      name_("socketcand " + std::string(listener_bus) + " " + peer_),
+      slow_(ctx_->options.slow_client_limit) {
   drain_timer_.emplace(ctx_->scheduler, [this] { OnDrainTimeout(); });
   settle_timer_.emplace(ctx_->scheduler, [this] {
     if (!ctx_->stopped) ReleaseHeld();
@@ -294,9 +295,16 @@ void Session::Deliver(std::span<const broker::TimedFrame> frames) {
   for (const auto& f : frames) {
     if (out.size() >= ctx_->options.max_output_bytes) {
       ++ctx_->stats.output_drops;
-      if (!overflowing_) {
-        overflowing_ = true;
+      if (!slow_.Dropping())
         spdlog::warn("{}: client does not keep up; dropping frames ({} bytes waiting)", name_, out.size());
+      if (slow_.Dropped(1, transport::SlowReader::Clock::now()) && !slow_close_posted_) {
+        // Not now: this runs inside the broker's delivery, which must not see its port go.
+        slow_close_posted_ = true;
+        asio::post(socket_.get_executor(), [self = shared_from_this()] {
+          ++self->ctx_->stats.slow_clients;
+          spdlog::warn("{}: {}; disconnected", self->name_, self->slow_.Reason("frames"));
+          self->Close(self->slow_.Reason("frames"));
+        });
       }
       continue;
     }
@@ -358,7 +366,7 @@ void Session::Write() {
     writing_.clear();
     written_ = 0;
     if (pending_.empty()) {
-      if (overflowing_) overflowing_ = false;
+      slow_.CaughtUp();
       if (closing_) Close(closing_reason_);
       return;
     }

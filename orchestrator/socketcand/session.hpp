@@ -34,6 +34,7 @@
 #include "orchestrator/broker/port_sink.hpp"
 #include "orchestrator/socketcand/protocol.hpp"
 #include "orchestrator/socketcand/server.hpp"
+#include "orchestrator/transport/slow_reader.hpp"
 
 namespace canfleet::socketcand::detail {
 
@@ -128,7 +129,9 @@ class Session final : public broker::PortSink, public std::enable_shared_from_th
   bool write_active_ = false;
   std::uint64_t queued_bytes_ = 0;   ///< total appended to pending_
   std::uint64_t written_bytes_ = 0;  ///< total written to the socket
-  bool overflowing_ = false;         ///< dropping frames for a slow client (logged once per episode)
+  /// Frames dropped for a slow client; disconnected after ServerOptions::slow_client_limit.
+  transport::SlowReader slow_;
+  bool slow_close_posted_ = false;
 
   /// Raw-mode settle (ServerOptions::raw_settle): frames go to held_ until the "< ok >" has been
   /// written (written_bytes_ reaches settle_after_) and the settle time has passed.

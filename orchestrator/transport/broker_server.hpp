@@ -32,7 +32,10 @@ class TimeConductor;
 struct BrokerServerOptions {
   /// Bytes a session may have waiting for a slow reader; deliveries beyond it are dropped and
   /// counted (a receiver that does not read loses frames, like a CAN controller's overrun).
-  std::size_t max_backlog_bytes = std::size_t{64} << 20;
+  std::size_t max_backlog_bytes = std::size_t{16} << 20;
+  /// A session whose backlog has stayed full this long (frames dropped all along) is
+  /// disconnected with the reason logged (transport/slow_reader.hpp); its node reconnects.
+  std::chrono::milliseconds slow_reader_limit{10'000};
   /// A connection that has not sent its Hello by then is closed.
   std::chrono::milliseconds hello_timeout{10'000};
   /// After a protocol error, how long the Error message may take to leave before the socket is
@@ -64,6 +67,7 @@ struct BrokerServerStats {
   std::uint64_t refused_connections = 0;  ///< refused before a Hello: no or wrong token, too many
   std::uint64_t protocol_errors = 0;      ///< connections closed for malformed or out-of-order data
   std::uint64_t backlog_drops = 0;        ///< frames not sent to slow readers
+  std::uint64_t slow_readers = 0;         ///< sessions closed for not reading (slow_reader_limit)
   std::uint64_t filtered_frames = 0;      ///< frames not sent to a node whose acceptance filter rejects them
   std::uint64_t node_requests = 0;        ///< RequestNode calls
   std::uint64_t node_replies = 0;         ///< of those, answered by the node (error or not)

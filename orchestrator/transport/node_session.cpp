@@ -55,7 +55,8 @@ NodeSession::NodeSession(broker::Broker& broker, const BrokerServerOptions& opti
       timer_(socket_.get_executor()),
       label_(std::move(label)),
       on_closed_(std::move(on_closed)),
-      attach_counter_(attach_counter) {}
+      attach_counter_(attach_counter),
+      slow_(options.slow_reader_limit) {}
 
 NodeSession::~NodeSession() {
   // Close() detaches before the last reference goes; this only guards a session that never ran.
@@ -436,11 +437,21 @@ void NodeSession::CloseSocket() {
   socket_.close(ignored);
 }
 
+void NodeSession::Overflow(std::size_t frames) {
+  if (closed_) return;
+  if (!slow_.Dropping()) spdlog::warn("{}: not reading; dropping frames for it", label_);
+  stats_->backlog_drops += frames;
+  if (!slow_.Dropped(frames, SlowReader::Clock::now())) return;
+  // Not now: this runs inside the broker's delivery, which must not see its port go.
+  asio::post(socket_.get_executor(), [this, self = shared_from_this(), reason = slow_.Reason("frames")] {
+    stats_->slow_readers++;
+    Close(reason, Farewell::kNone, spdlog::level::warn);
+  });
+}
+
 void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
   if (filling_.size() >= options_.max_backlog_bytes) {
-    if (backlog_drops_ == 0) spdlog::warn("{}: not reading; dropping frames for it", label_);
-    backlog_drops_ += frames.size();
-    stats_->backlog_drops += frames.size();
+    Overflow(frames.size());
     return;
   }
   if (!accept_all_) {
@@ -464,9 +475,7 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
   for (const broker::FrameRun& run : runs)
     frames += run.size();
   if (filling_.size() >= options_.max_backlog_bytes) {
-    if (backlog_drops_ == 0) spdlog::warn("{}: not reading; dropping frames for it", label_);
-    backlog_drops_ += frames;
-    stats_->backlog_drops += frames;
+    Overflow(frames);
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
@@ -613,10 +622,8 @@ void NodeSession::Written() {
     CloseSocket();
     return;
   }
-  if (backlog_drops_ != 0) {
-    spdlog::warn("{}: reading again; {} frames were dropped", label_, backlog_drops_);
-    backlog_drops_ = 0;
-  }
+  if (const auto lost = slow_.CaughtUp(); lost != 0)
+    spdlog::warn("{}: reading again; {} frames were dropped", label_, lost);
 }
 
 }  // namespace canfleet::transport::detail

@@ -23,6 +23,7 @@
 #include "bus/wire/stream_decoder.hpp"
 #include "orchestrator/broker/broker.hpp"
 #include "orchestrator/transport/broker_server.hpp"
+#include "orchestrator/transport/slow_reader.hpp"
 #include "orchestrator/transport/time_conductor.hpp"
 
 namespace canfleet::transport::detail {
@@ -165,7 +166,9 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   wire::MessageWriter writing_;  ///< the unwritten rest of a write the socket took only in part
   bool write_in_flight_ = false;
   bool flush_posted_ = false;
-  std::uint64_t backlog_drops_ = 0;  ///< frames dropped in the current backlog episode
+  /// Frames dropped for a full backlog; disconnects after BrokerServerOptions::slow_reader_limit.
+  SlowReader slow_;
+  void Overflow(std::size_t frames);
 
   /// NodeRequests waiting for their reply, by the id this session gave them.
   struct PendingRequest {

@@ -418,6 +418,31 @@ TEST_F(Transport, ASlowReaderLosesFramesAndNobodyElseDoes) {
       << log.Text();
 }
 
+TEST_F(Transport, ANodeThatStaysBehindIsDisconnectedWithTheReason) {
+  // Issue 32: a client that cannot keep up is not held with a full queue for ever: once its
+  // backlog has been full for slow_reader_limit, its session is closed and the reason logged.
+  LogCapture log;
+  broker_.AddBus({.name = "fast", .bitrate = 1'000'000, .paced = false, .tx_queue_capacity = 1 << 20});
+  transport::BrokerServer server(io_, broker_, {.max_backlog_bytes = 64 * 1024, .slow_reader_limit = 300ms});
+  const std::string ep = Listen(server);
+  RawConnection sleeper(ep);  // says Hello, then never reads
+  wire::MessageWriter hello;
+  hello.AddHello(wire::MakeHello("fast", "sleeper"));
+  ASSERT_TRUE(sleeper.Send(std::vector<std::uint8_t>(hello.Bytes().begin(), hello.Bytes().end())));
+  ASSERT_TRUE(RunUntil([&] { return broker_.Ports("fast").size() == 1; }));
+  NullSink sink;
+  const broker::PortId sender = broker_.Attach("fast", "sender", sink);
+  std::vector<CanFrame> burst(1000, CanFrame::Data(0x181, {1, 2, 3, 4, 5, 6, 7, 8}));
+  ASSERT_TRUE(RunUntil([&] {
+    broker_.Submit(sender, burst);
+    return server.Stats().slow_readers == 1;
+  })) << "the sleeper is still connected";
+  EXPECT_EQ(broker_.Ports("fast").size(), 1u) << "only the sender is left";
+  EXPECT_NE(log.Text().find("[sleeper on fast, port 1]: closed: not reading:"), std::string::npos)
+      << log.Text();
+  EXPECT_NE(log.Text().find("frames dropped over 300 ms"), std::string::npos) << log.Text();
+}
+
 TEST_F(Transport, ASlowReaderGetsEveryFrameInOrderWhenItsSocketFills) {
   // When a delivery goes to the socket only in part (its buffer is full), the rest is kept and
   // written later, and later deliveries queue behind it: the byte stream stays whole. The reader

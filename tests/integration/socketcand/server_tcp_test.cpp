@@ -193,6 +193,26 @@ TEST(SocketcandTcp, SlowClientsOutputIsBounded) {
   }
 }
 
+// Issue 32: a client that stays behind is not kept with a full queue for ever: once frames have
+// been dropped for it for slow_client_limit, it is disconnected.
+TEST(SocketcandTcp, AClientThatStaysBehindIsDisconnected) {
+  ServerOptions o = Compact();
+  o.max_output_bytes = 4096;
+  o.slow_client_limit = 200ms;
+  Endpoint ep(o, {.name = "can0", .bitrate = 1'000'000, .paced = false, .tx_queue_capacity = 100'000});
+  Client c(ep.port(), 1024);
+  ASSERT_TRUE(c.Handshake());
+  std::vector<CanFrame> frames(2000, CanFrame::Data(0x100, {1, 2}));
+  auto stats = ep.Stats();
+  for (int i = 0; i < 3000 && stats.slow_clients == 0; ++i) {
+    ep.Send(frames);
+    std::this_thread::sleep_for(10ms);
+    stats = ep.Stats();
+  }
+  EXPECT_EQ(stats.slow_clients, 1u);
+  EXPECT_GT(stats.output_drops, 0u);
+}
+
 // A CAN driver sends what was queued before its socket closed: a script that sends a burst and
 // exits at once loses nothing.
 TEST(SocketcandTcp, FramesSentJustBeforeClosingStillReachTheBus) {
