@@ -30,6 +30,9 @@ struct ControlServerOptions {
   /// A connection whose backlog has stayed full this long (batches dropped all along) is closed
   /// with the reason logged (transport/slow_reader.hpp).
   std::chrono::milliseconds slow_reader_limit{30'000};
+  /// A message begun (its length prefix or part of its body read) must be complete this long
+  /// after; else the connection is closed as a protocol error.
+  std::chrono::milliseconds message_timeout{30'000};
   /// When a connection is closed by the server (protocol error, Close), how long what is queued
   /// (an error response, a Shutdown's Done) may take to leave before the socket is closed anyway.
   std::chrono::milliseconds close_linger{1'000};

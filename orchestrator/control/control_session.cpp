@@ -57,6 +57,7 @@ ControlSession::ControlSession(asio::ip::tcp::socket socket, ControlHandler& han
       options_(options),
       stats_(std::move(stats)),
       linger_(socket_.get_executor()),
+      incomplete_(socket_.get_executor()),
       label_(std::move(label)),
       on_closed_(std::move(on_closed)),
       reader_(options.max_message),
@@ -87,7 +88,26 @@ void ControlSession::Read() {
       Dispatch(request_);
       if (closed_) return;  // the handler closed the server (a Shutdown)
     }
+    WatchIncomplete();
     Read();
+  });
+}
+
+void ControlSession::WatchIncomplete() {
+  // A message begun must be finished within message_timeout: a client that sends part of one (a
+  // length prefix of 1 MiB, then nothing) would otherwise hold that memory for as long as it likes.
+  if (reader_.Buffered() == 0) {
+    incomplete_since_armed_ = false;
+    incomplete_.cancel();
+    return;
+  }
+  if (incomplete_since_armed_) return;
+  incomplete_since_armed_ = true;
+  incomplete_.expires_after(options_.message_timeout);
+  incomplete_.async_wait([this, self = shared_from_this()](const asio::error_code& ec) {
+    if (ec || closed_ || !incomplete_since_armed_) return;
+    ProtocolError("a message begun " + std::to_string(options_.message_timeout.count()) +
+                  " ms ago is still incomplete (" + std::to_string(reader_.Buffered()) + " bytes)");
   });
 }
 
@@ -205,6 +225,7 @@ void ControlSession::Flush() {
 void ControlSession::CloseSocket() {
   asio::error_code ignored;
   linger_.cancel();
+  incomplete_.cancel();
   socket_.shutdown(asio::socket_base::shutdown_both, ignored);
   socket_.close(ignored);
 }

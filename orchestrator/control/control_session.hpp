@@ -43,6 +43,7 @@ class ControlSession final : public std::enable_shared_from_this<ControlSession>
 
  private:
   void Read();
+  void WatchIncomplete();
   void Dispatch(const Request& request);
   void ProtocolError(const std::string& reason);
   void Flush();
@@ -53,6 +54,8 @@ class ControlSession final : public std::enable_shared_from_this<ControlSession>
   const ControlServerOptions options_;
   std::shared_ptr<ControlServerStats> stats_;
   asio::steady_timer linger_;
+  asio::steady_timer incomplete_;  ///< a message begun and not finished (message_timeout)
+  bool incomplete_since_armed_ = false;
   std::string label_;  ///< "control session 3 (127.0.0.1:40312)"
   ClosedHandler on_closed_;
   std::shared_ptr<Responder> responder_;

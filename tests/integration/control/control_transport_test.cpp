@@ -633,5 +633,19 @@ TEST_F(ControlTransport, SessionsAreBoundedAndTheNextClientIsTold) {
   EXPECT_EQ(OnIo([&] { return server_->SessionCount(); }), 2u);
 }
 
+TEST_F(ControlTransport, AMessageBegunAndNeverFinishedClosesTheConnection) {
+  // Issue 32: a length prefix of 1000 bytes and 10 of them, then nothing: the connection may not
+  // hold what it sent (up to the 1 MiB limit) for as long as it likes.
+  Start({.message_timeout = 100ms});
+  RawClient raw(PortOf(endpoint_));
+  raw.Send(std::string("\xE8\x07", 2) + std::string(10, 'x'));
+  const auto got = raw.ReadUntilClosed();
+  ASSERT_TRUE(got.has_value()) << "still open";
+  const auto responses = Responses(*got);
+  ASSERT_EQ(responses.size(), 1u);
+  EXPECT_NE(responses[0].error().find("still incomplete (12 bytes)"), std::string::npos)
+      << responses[0].error();
+}
+
 }  // namespace
 }  // namespace canfleet::control
