@@ -44,7 +44,7 @@ struct ControlServerOptions {
   /// Connections waiting at the gate at once; one more is closed at once.
   std::size_t max_pending = 64;
   /// Sessions at once; one more is refused with an error Response saying so.
-  std::size_t max_sessions = 128;
+  std::size_t max_sessions = 64;
 };
 
 struct ControlServerStats {

@@ -1,5 +1,7 @@
 #include "orchestrator/host/broker_host.hpp"
 
+#include <malloc.h>
+
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -25,6 +27,17 @@ std::unique_ptr<transport::TimeConductor> MakeConductor(asio::io_context& io, Sc
   if (!time.virtual_time) return nullptr;
   return std::make_unique<transport::TimeConductor>(io, static_cast<GrantedScheduler&>(scheduler), broker,
                                                     time.conductor);
+}
+
+/// Large buffers straight from and back to the kernel. glibc raises its mmap threshold (up to
+/// 32 MiB) after the first large block is freed, after which what a flood of clients made the
+/// orchestrator buffer (session queues, half-sent messages) stays in the heap once they are gone:
+/// 16 MiB before such a flood, 108 MiB after it. A fixed threshold keeps every block above it an
+/// mmap of its own, returned when freed; the hot paths reuse their buffers, so this costs no
+/// syscalls per frame.
+void ReturnLargeBlocksWhenFreed() {
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+  mallopt(M_TRIM_THRESHOLD, 1024 * 1024);
 }
 
 transport::BrokerServerOptions ServerOptions(transport::TimeConductor* conductor, WallTime wall_origin) {
@@ -59,7 +72,9 @@ BrokerHost::BrokerHost(asio::io_context& io, socketcand::ServerOptions socketcan
       server_(io, broker_, ServerOptions(conductor_.get(), wall_origin_)),
       socketcand_(io, broker_, *scheduler_, WithOrigin(std::move(socketcand_options), wall_origin_)),
       signals_(io, SIGINT, SIGTERM),
-      drain_(io) {}
+      drain_(io) {
+  ReturnLargeBlocksWhenFreed();
+}
 
 BrokerHost::~BrokerHost() {
   // Dispose the buses' BusStats (monitors drop them) before the broker goes.

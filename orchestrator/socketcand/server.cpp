@@ -57,6 +57,20 @@ void Listener::OnAccept(const asio::error_code& ec, asio::ip::tcp::socket socket
   }
   asio::error_code peer_ec;
   const auto peer = socket.remote_endpoint(peer_ec);
+  if (ctx->stats.sessions_open >= ctx->options.max_sessions) {
+    // Each session may queue max_output_bytes for its client: the number of them bounds the memory.
+    ++ctx->stats.sessions_refused;
+    spdlog::warn("socketcand {}: refused {}: {} sessions open (the limit)", bus,
+                 peer_ec ? std::string("unknown peer") : peer.address().to_string(),
+                 ctx->options.max_sessions);
+    static constexpr char kRefusal[] = "< error too many connections >";
+    asio::error_code ignored;
+    socket.send(asio::buffer(kRefusal, sizeof kRefusal - 1), asio::socket_base::message_flags(MSG_DONTWAIT),
+                ignored);
+    socket.close(ignored);
+    Accept();
+    return;
+  }
   socket.set_option(asio::ip::tcp::no_delay(true), peer_ec);  // as socketcand: one frame, one segment
   StartSession(
       ctx, asio::generic::stream_protocol::socket(std::move(socket)), bus,

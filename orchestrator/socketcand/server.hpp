@@ -45,6 +45,10 @@ struct ServerOptions {
   /// Bytes a session may have waiting for a slow client. Frames beyond are dropped and counted
   /// (as a SocketCAN socket's full receive queue drops them), never buffered without bound.
   std::size_t max_output_bytes = std::size_t{4} << 20;
+  /// Sessions open at once (every bus of the server): beyond, a new client gets
+  /// "< error too many connections >" and is closed. With max_output_bytes, this bounds the memory
+  /// clients that do not read can take.
+  std::size_t max_sessions = 32;
   /// A client whose output has stayed full this long (frames dropped all along) is disconnected
   /// with the reason logged (transport/slow_reader.hpp).
   std::chrono::milliseconds slow_client_limit{10'000};
@@ -68,6 +72,7 @@ struct ServerStats {
   std::uint64_t frames_to_clients = 0;    ///< frames written to clients
   std::uint64_t frames_from_clients = 0;  ///< frames accepted by the broker
   std::uint64_t output_drops = 0;         ///< frames dropped for a slow client (max_output_bytes)
+  std::uint64_t sessions_refused = 0;     ///< clients refused beyond max_sessions
   std::uint64_t slow_clients = 0;         ///< clients disconnected for not reading (slow_client_limit)
   std::uint64_t submit_drops = 0;         ///< client frames the broker refused (bus-off, queue full)
   std::uint64_t protocol_errors = 0;      ///< malformed or unsupported commands

@@ -73,6 +73,11 @@ void Session::Close(std::string_view reason) {
   asio::error_code ec;
   socket_.shutdown(asio::socket_base::shutdown_both, ec);
   socket_.close(ec);
+  // What was queued for the client goes now, not when the server next prunes its closed sessions
+  // (a client that never read may have left max_output_bytes here). writing_ stays: a write in
+  // flight may still refer to it until its handler runs.
+  std::string().swap(pending_);
+  std::string().swap(held_);
   if (ctx_->stats.sessions_open > 0) --ctx_->stats.sessions_open;
 }
 
