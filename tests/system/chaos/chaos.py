@@ -416,6 +416,7 @@ if __name__ == "__main__":
     p.add_argument("--folder", type=Path, default=None)
     args = p.parse_args()
     folder = args.folder or Path(tempfile.mkdtemp(prefix="canfleet-chaos-"))
+    folder.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
     report = Chaos(folder, args.seed).run(args.duration)
     print(f"chaos: {args.duration:g} s, seed {args.seed}, state {folder}, wall {time.monotonic() - t0:.0f} s")
