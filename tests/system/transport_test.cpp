@@ -263,6 +263,21 @@ TEST_F(Transport, BeyondLoopbackWithoutATokenTheBrokerDoesNotListen) {
   EXPECT_THROW(server.Listen(wire::Endpoint::Parse("tcp://0.0.0.0:0")), std::runtime_error);
 }
 
+TEST_F(Transport, SessionsBeyondTheLimitAreRefusedWithTheReason) {
+  // Issue 32: connections are bounded per endpoint; one more is told why in its HelloReply.
+  transport::BrokerServer server(io_, broker_, {.max_sessions = 1});
+  const std::string ep = Listen(server);
+  auto first = Client(ep, "first");
+  ASSERT_TRUE(RunUntil([&] { return first->Connected(); }));
+  auto second = Client(ep, "second");
+  std::vector<std::string> connection;
+  second->OnConnection(
+      [&](bool up, const std::string& detail) { connection.push_back((up ? "up " : "down ") + detail); });
+  ASSERT_TRUE(RunUntil([&] { return !connection.empty(); }));
+  EXPECT_EQ(connection[0], "down refused: too many connections to this broker (limit 1)");
+  EXPECT_EQ(server.SessionCount(), 1u);
+}
+
 TEST_F(Transport, ConnectionWithoutHelloIsClosedAfterTheDeadline) {
   transport::BrokerServer server(io_, broker_, {.hello_timeout = 200ms});
   const std::string ep = Listen(server);

@@ -213,6 +213,21 @@ TEST(SocketcandTcp, AClientThatStaysBehindIsDisconnected) {
   EXPECT_GT(stats.output_drops, 0u);
 }
 
+// Issue 32: sessions are bounded (each may queue max_output_bytes): one more is told and closed.
+TEST(SocketcandTcp, SessionsBeyondTheLimitAreRefused) {
+  ServerOptions o = Compact();
+  o.max_sessions = 2;
+  Endpoint ep(o, {.name = "can0", .bitrate = 1'000'000, .paced = false});
+  Client a(ep.port()), b(ep.port());
+  ASSERT_TRUE(a.Handshake());
+  ASSERT_TRUE(b.Handshake());
+  Client c(ep.port());
+  const auto refusal = c.Next();
+  ASSERT_TRUE(refusal.has_value());
+  EXPECT_EQ(*refusal, "< error too many connections >");
+  EXPECT_EQ(ep.Stats().sessions_refused, 1u);
+}
+
 // A CAN driver sends what was queued before its socket closed: a script that sends a burst and
 // exits at once loses nothing.
 TEST(SocketcandTcp, FramesSentJustBeforeClosingStillReachTheBus) {

@@ -319,15 +319,20 @@ class Chaos:
     def hostile_clients(self) -> None:
         """Silent connections, garbage and a client that never reads, on every port."""
         assert self.fleet is not None
-        ports = [int(self.fleet.control.rsplit(":", 1)[1])] + list(self.socketcand_ports.values())
-        if self.fleet.broker and self.fleet.broker.startswith("tcp://"):
-            ports.append(int(self.fleet.broker.rsplit(":", 1)[1]))
+        ports: List[Callable[[], socket.socket]] = [
+            lambda port=port: socket.create_connection(("127.0.0.1", port), timeout=5)  # type: ignore[misc]
+            for port in [int(self.fleet.control.rsplit(":", 1)[1])] + list(self.socketcand_ports.values())]
+        broker = self.fleet.broker or ""
+        if broker.startswith("tcp://"):
+            ports.append(lambda: socket.create_connection(("127.0.0.1", int(broker.rsplit(":", 1)[1])), timeout=5))
+        elif broker.startswith("unix://"):
+            ports.append(lambda: _unix_connection(broker[len("unix://"):]))
         held: List[socket.socket] = []
         try:
-            for port in ports:
+            for connect in ports:
                 for _ in range(30):  # silent
-                    held.append(socket.create_connection(("127.0.0.1", port), timeout=5))
-                garbage = socket.create_connection(("127.0.0.1", port), timeout=5)
+                    held.append(connect())
+                garbage = connect()
                 garbage.sendall(bytes(self.random.getrandbits(8) for _ in range(8192)))
                 held.append(garbage)
             # a socketcand client that asks for every frame and never reads
@@ -391,6 +396,13 @@ class Chaos:
             if self.fleet is not None:
                 self.down()
         return self.report
+
+
+def _unix_connection(path: str) -> socket.socket:
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.settimeout(5)
+    s.connect(path)
+    return s
 
 
 def _free_port() -> int:
