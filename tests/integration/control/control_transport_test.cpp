@@ -611,6 +611,15 @@ TEST_F(ControlTransport, AClientThatSaysNothingIsClosedAfterTheHandshakeTimeout)
   EXPECT_EQ(OnIo([&] { return server_->GateStats().timed_out; }), 1u);
 }
 
+TEST_F(ControlTransport, OnLoopbackAClientThatSaysNothingYetBecomesASession) {
+  // The Python clock connects first and speaks at the test's first step: no token needed on
+  // loopback, so silence is no reason to refuse; the session counts against max_sessions.
+  Start({.handshake_timeout = 100ms});
+  RawClient raw(PortOf(endpoint_));
+  ASSERT_TRUE(WaitUntil([&] { return OnIo([&] { return server_->SessionCount(); }) == 1; }));
+  EXPECT_EQ(OnIo([&] { return server_->GateStats().timed_out; }), 1u);
+}
+
 TEST_F(ControlTransport, ConnectionsWaitingAtTheGateAreBounded) {
   Start({.token = kToken, .max_pending = 2}, "tcp://0.0.0.0:0");
   RawClient a(PortOf(endpoint_)), b(PortOf(endpoint_));
