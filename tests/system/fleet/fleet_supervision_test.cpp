@@ -183,8 +183,13 @@ TEST(FleetFrames, DumpAndCaptureShowTheBusTraffic) {
   EXPECT_EQ(std::count(dump.out.begin(), dump.out.end(), '\n'), 3) << dump.out;
   EXPECT_NE(dump.out.find(" can0 705#05"), std::string::npos) << dump.out;
 
-  const std::string pcap = fleet.dir().File("can0.pcap");
-  ASSERT_EQ(fleet.Cli({"capture", "start", "--bus", "can0", "--file", pcap}).exit_code, 0);
+  // A relative file goes to the fleet's capture folder; the answer names where.
+  const auto started_capture = fleet.Cli({"capture", "start", "--bus", "can0", "--file", "can0.pcap"});
+  ASSERT_EQ(started_capture.exit_code, 0) << started_capture.err;
+  const auto arrow = started_capture.out.find(" -> ");
+  ASSERT_NE(arrow, std::string::npos) << started_capture.out;
+  const std::string pcap = started_capture.out.substr(arrow + 4, started_capture.out.find('\n') - arrow - 4);
+  EXPECT_NE(pcap.find("/captures/can0.pcap"), std::string::npos) << pcap;
   const double started = fleet.Status().uptime_s();
   ASSERT_TRUE(WaitUntil([&] { return fleet.Status().uptime_s() > started + 1.0; }, kLong));
   const auto stopped = fleet.Cli({"capture", "stop"});
