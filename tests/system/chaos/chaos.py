@@ -120,6 +120,18 @@ class Prober(threading.Thread):
             self.figures = {"rss_start": rss, "rss_end": rss, "rss_max": rss, "fds_start": fds, "fds_end": fds,
                             "fds_max": fds}
 
+    def final_sample(self) -> None:
+        """The incarnation's end figures, once what the last event left has had a second to go."""
+        time.sleep(1.0)
+        with self.lock:
+            if self.pid is None or not self.figures:
+                return
+            try:
+                rss, fds = proc_figures(self.pid)
+            except OSError:
+                return
+            self.figures["rss_end"], self.figures["fds_end"] = rss, fds
+
     def detach(self) -> None:
         with self.lock:
             if self.figures:
@@ -352,6 +364,7 @@ class Chaos:
     def kill_orchestrator(self) -> None:
         assert self.fleet is not None and self.fleet.pid is not None
         pids = [n.pid for n in self.statuses() if n.pid]
+        self.prober.final_sample()
         os.kill(self.fleet.pid, signal.SIGKILL)
         self.report.count("orchestrator killed (kill -9)")
         self.prober.detach()
@@ -387,6 +400,7 @@ class Chaos:
                 self.log(f"chaos: {event.__name__} ({left:.0f} s left)")
                 event()
             # the end: the fleet stops cleanly, and nothing is left running
+            self.prober.final_sample()
             pids = list(self.node_pids)
             self.down()
             self.report.leftover_processes += sum(1 for p in pids if _alive(p))
