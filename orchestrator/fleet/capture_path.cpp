@@ -23,6 +23,11 @@ std::string List(const std::vector<fs::path>& folders) {
 
 }  // namespace
 
+CaptureFolders CaptureFoldersAt(const fs::path& dir, const fs::path& state_root) {
+  const auto base = fs::absolute(dir).lexically_normal();
+  return {base, {base, fs::absolute(state_root).lexically_normal()}};
+}
+
 fs::path ResolveCapturePath(const std::string& requested, const CaptureFolders& folders) {
   if (requested.empty()) throw std::invalid_argument("capture needs a file (--file)");
   const fs::path given(requested);

@@ -17,6 +17,10 @@ struct CaptureFolders {
   std::vector<std::filesystem::path> allowed;
 };
 
+/// The folders of a fleet whose captures go to `dir` (absolute or relative to the working folder)
+/// and may also go anywhere in its state root.
+CaptureFolders CaptureFoldersAt(const std::filesystem::path& dir, const std::filesystem::path& state_root);
+
 /// The absolute path to write `requested` to, its parent folders created. Throws
 /// std::invalid_argument saying why when the path is empty, names a folder, resolves (symbolic
 /// links followed) outside every allowed folder, or names a file that exists.

@@ -53,9 +53,8 @@ RestartPolicy PolicyOf(const topology::Node& node) {
 
 CaptureFolders CaptureFoldersOf(const FleetOptions& options) {
   if (options.capture_folders) return *options.capture_folders;
-  const std::filesystem::path root =
-      std::filesystem::absolute(options.topology.orchestrator().state_root()).lexically_normal();
-  return {root / "captures", {root}};
+  const auto& root = options.topology.orchestrator().state_root();
+  return CaptureFoldersAt(std::filesystem::path(root) / "captures", root);
 }
 
 }  // namespace

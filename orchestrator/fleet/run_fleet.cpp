@@ -141,11 +141,8 @@ int RunFleet(const UpOptions& options) {
     fleet_options.seed = spec.time().seed();
     fleet_options.scenario_source = options.topology.string();
     fleet_options.step_lines = loaded.step_lines;
-    if (!options.capture_dir.empty()) {
-      const auto dir = std::filesystem::absolute(options.capture_dir).lexically_normal();
-      fleet_options.capture_folders = CaptureFolders{
-          dir, {dir, std::filesystem::absolute(spec.orchestrator().state_root()).lexically_normal()}};
-    }
+    if (!options.capture_dir.empty())
+      fleet_options.capture_folders = CaptureFoldersAt(options.capture_dir, spec.orchestrator().state_root());
     UseHostTime(fleet_options, host.conductor());
     fleet =
         std::make_unique<Fleet>(io, host.scheduler(), host.broker(), host.server(), std::move(fleet_options));

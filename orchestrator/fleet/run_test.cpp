@@ -145,11 +145,8 @@ class FileRun {
       fleet_options.seed = options_.seed ? *options_.seed : spec.time().seed();
       fleet_options.scenario_source = report_.file;
       fleet_options.step_lines = lines_;
-      if (!options_.capture.empty()) {
-        const auto dir = fs::absolute(options_.capture).lexically_normal();
-        fleet_options.capture_folders =
-            CaptureFolders{dir, {dir, fs::absolute(spec.orchestrator().state_root()).lexically_normal()}};
-      }
+      if (!options_.capture.empty())
+        fleet_options.capture_folders = CaptureFoldersAt(options_.capture, spec.orchestrator().state_root());
       UseHostTime(fleet_options, host.conductor());
       fleet = std::make_unique<Fleet>(io, scheduler, host.broker(), host.server(), std::move(fleet_options));
       control_server =
