@@ -10,6 +10,8 @@ void ReleaseFreedHeap() {
 
 void UseOneMallocArena() {
   mallopt(M_ARENA_MAX, 1);
+  mallopt(M_TOP_PAD, 0);
+  mallopt(M_TRIM_THRESHOLD, 64 * 1024);
 }
 
 }  // namespace canfleet::node
