@@ -173,7 +173,7 @@ TEST(CommitRecordTest, NamesOutsideTheDirectoryAreRejected) {
 // ---- Recovery from every crash point of a save all
 
 enum class Record : std::uint8_t { kNone, kValid, kTorn, kCorrupt };
-constexpr unsigned kComm = 1, kMfr = 2, kApp = 4, kAll = 7;
+constexpr unsigned kComm = 1, kMfr = 2, kApp = 4, kAll = kComm | kMfr | kApp;
 
 /// The state a kill leaves at one point of StoreTransaction::Commit.
 struct CrashPoint {
