@@ -54,6 +54,10 @@ class BusPort {
     return false;
   }
 
+  /// What the node listens to changed outside an answer to a command (a power supply falling
+  /// asleep wakes on any frame): a port with an acceptance filter sends the new one now.
+  virtual void AcceptanceMayHaveChanged() {}
+
   void OnReceive(ReceiveHandler handler) { receive_ = std::move(handler); }
   void OnStateChange(StateHandler handler) { state_change_ = std::move(handler); }
 

@@ -38,6 +38,11 @@ void Scheduler::RunDue(TimePoint limit, const std::function<void(TimePoint)>& on
     Disarm(*t);
     if (on_each) on_each(t->deadline_);
     ++fired_;
+    struct Confined {
+      std::uint32_t& running;
+      ~Confined() { running = Timer::kUnconfined; }
+    } confined{running_confinement_};
+    running_confinement_ = t->confinement_;
     t->on_expiry_();  // may re-arm t or touch other timers; the heap is consistent here
   }
 }
@@ -118,7 +123,26 @@ void Scheduler::Remove(Heap& heap, Timer& timer) {
   }
 }
 
+void Scheduler::TakeOutlook(TimerOutlook& out) const {
+  out.unconfined.reset();
+  out.confined.clear();
+  for (const Timer* t : heap_) {
+    if (t->confinement_ == Timer::kUnconfined) {
+      if (!out.unconfined || t->deadline_ < *out.unconfined) out.unconfined = t->deadline_;
+      continue;
+    }
+    auto it = std::lower_bound(out.confined.begin(), out.confined.end(), t->confinement_,
+                               [](const auto& entry, std::uint32_t key) { return entry.first < key; });
+    if (it != out.confined.end() && it->first == t->confinement_)
+      it->second = std::min(it->second, t->deadline_);
+    else
+      out.confined.insert(it, {t->confinement_, t->deadline_});
+  }
+}
+
 void Scheduler::Arm(Timer& timer, TimePoint deadline) {
+  if (running_confinement_ != Timer::kUnconfined && timer.confinement_ != running_confinement_)
+    ++confinement_breaches_;
   if (timer.Asleep()) {
     Remove(sleeping_, timer);
     timer.sleep_period_ = Duration::zero();
@@ -165,6 +189,8 @@ void Scheduler::Sleep(Timer& timer, Duration period) {
 
 void Scheduler::Wake(Timer& timer) {
   if (!timer.Asleep()) return;
+  if (running_confinement_ != Timer::kUnconfined && timer.confinement_ != running_confinement_)
+    ++confinement_breaches_;
   CatchUpSleepers();
   Remove(sleeping_, timer);
   timer.sleep_period_ = Duration::zero();

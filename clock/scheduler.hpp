@@ -32,6 +32,17 @@ using Duration = SchedulerClock::duration;
 
 class Timer;
 
+/// Lock-step virtual time grants a node process as far as nothing it listens to can reach it
+/// (issue 34, orchestrator/transport/grant_horizon.hpp), which needs to know who may send what
+/// when. A timer whose callback has one narrow effect says so (Timer::Confine): a node's heartbeat
+/// producer sends only its heartbeat's identifier, a TPDO's event timer only the TPDO's.
+struct TimerOutlook {
+  /// The earliest timer that may do anything (not confined); nullopt: none is armed.
+  std::optional<TimePoint> unconfined;
+  /// For each confinement key of an armed timer, its earliest deadline (ascending keys).
+  std::vector<std::pair<std::uint32_t, TimePoint>> confined;
+};
+
 /// Owns the queue of armed timers. Not thread-safe: used from the thread of one event loop.
 class Scheduler {
  public:
@@ -53,6 +64,14 @@ class Scheduler {
   std::size_t SleepingCount() const { return sleeping_.size(); }
   /// Callbacks run since construction: the work the clock caused (tests count wake-ups with it).
   std::uint64_t FiredCount() const { return fired_; }
+
+  /// What the armed timers may do next (TimerOutlook); O(armed timers).
+  void TakeOutlook(TimerOutlook& out) const;
+  /// Inside a timer's callback, its confinement (Timer::Confine); Timer::kUnconfined elsewhere.
+  std::uint32_t RunningConfinement() const { return running_confinement_; }
+  /// Timers armed or woken by a confined callback that are not confined alike: each breaks the
+  /// promise of that callback (its owner said it does only one thing).
+  std::uint64_t ConfinementBreaches() const { return confinement_breaches_; }
 
  protected:
   /// Runs every timer whose deadline is at or before `limit`, earliest first (ties in arming order).
@@ -87,6 +106,8 @@ class Scheduler {
   std::uint64_t next_sequence_ = 0;
   std::uint64_t fired_ = 0;
   bool running_due_ = false;
+  std::uint32_t running_confinement_ = 0xFFFF'FFFF;
+  std::uint64_t confinement_breaches_ = 0;
 };
 
 /// A one-shot timer with a fixed callback, re-armable without allocation.
@@ -121,6 +142,15 @@ class Timer {
   void Wake();
   bool Asleep() const { return sleep_period_ > Duration::zero(); }
 
+  /// Anything: the default.
+  static constexpr std::uint32_t kUnconfined = 0xFFFF'FFFF;
+  /// States that the callback's only effect others may notice is the one `key` names, and that it
+  /// arms no timer confined otherwise (TimerOutlook). On a node, `key` is the 11-bit identifier of
+  /// the one frame it may send; a broker's bus confines its timer to the bus's own events.
+  /// kUnconfined takes the promise back.
+  void Confine(std::uint32_t key) { confinement_ = key; }
+  std::uint32_t Confinement() const { return confinement_; }
+
  private:
   friend class Scheduler;
   static constexpr std::size_t kNotArmed = static_cast<std::size_t>(-1);
@@ -130,6 +160,7 @@ class Timer {
   std::uint64_t sequence_ = 0;
   std::size_t heap_index_ = kNotArmed;  // into Scheduler::heap_, or sleeping_ while asleep
   Duration sleep_period_{0};            // > 0 while asleep
+  std::uint32_t confinement_ = kUnconfined;
 };
 
 /// Simulated time for unit tests: time stands still until the test advances it.

@@ -74,6 +74,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
       ++stats_.tx_refused;
       return false;
     }
+    if (options_.virtual_time) CheckConfinement(frame);
     // In virtual time a frame carries the time it was sent: the broker puts it on the bus then.
     filling_.AddFrame(frame, options_.virtual_time
                                  ? options_.virtual_time->scheduler().Now().time_since_epoch()
@@ -84,6 +85,25 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   }
 
   ControllerState State() const { return state_; }
+
+  void AcceptanceMayHaveChanged() {
+    if (!options_.virtual_time && phase_ == Phase::kConnected) ScheduleFlush();  // Flush refreshes it
+  }
+
+  /// A timer confined to one identifier (Timer::Confine) promised to send only that: another frame
+  /// from it breaks what per-node lookahead grants others on (issue 34). Counted, and said once.
+  void CheckConfinement(const CanFrame& frame) {
+    const std::uint32_t key = options_.virtual_time->scheduler().RunningConfinement();
+    if (key == Timer::kUnconfined || (!frame.extended() && frame.id == key)) return;
+    ++stats_.confinement_breaches;
+    if (breach_logged_) return;
+    breach_logged_ = true;
+    spdlog::error(
+        "virtual time: a timer confined to identifier {:03X}h sent {:X}h: other nodes may have been granted "
+        "past "
+        "it (a bug of the node; grant_horizon.hpp)",
+        key, frame.id);
+  }
 
   void SetBitRate(std::uint32_t bitrate) {
     if (bitrate == options_.bitrate) return;
@@ -364,7 +384,12 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
     if (held_requests_.empty()) held_requests_.swap(requests);
   }
 
-  void Reached(TimePoint time, std::optional<TimePoint> next_deadline) override {
+  bool AcceptanceChanged() override {
+    if (!acceptance || phase_ != Phase::kConnected) return false;
+    return acceptance_sent_ && acceptance() != last_acceptance_;
+  }
+
+  void Reached(TimePoint time, std::optional<TimePoint> next_deadline, const TimerOutlook& outlook) override {
     if (phase_ != Phase::kConnected) return;
     if (acceptance) {
       auto ids = acceptance();
@@ -374,9 +399,22 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
         acceptance_sent_ = true;
       }
     }
+    // What its timers may send: its heartbeat and TPDO timers are confined to their identifiers;
+    // a key above 0x7FF (none on a node) would not be an identifier, so it counts as anything.
+    reached_outlook_.any_ns.reset();
+    reached_outlook_.confined.clear();
+    if (outlook.unconfined) reached_outlook_.any_ns = outlook.unconfined->time_since_epoch().count();
+    for (const auto& [key, deadline] : outlook.confined) {
+      const std::int64_t ns = deadline.time_since_epoch().count();
+      if (key <= 0x7FF)
+        reached_outlook_.confined.emplace_back(key, ns);
+      else
+        reached_outlook_.any_ns = std::min(reached_outlook_.any_ns.value_or(ns), ns);
+    }
     filling_.AddTimeReached(
         time.time_since_epoch().count(),
-        next_deadline ? std::optional(next_deadline->time_since_epoch().count()) : std::nullopt);
+        next_deadline ? std::optional(next_deadline->time_since_epoch().count()) : std::nullopt,
+        &reached_outlook_);
     ScheduleFlush();
   }
 
@@ -632,6 +670,8 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   /// The acceptance filter last sent on this connection.
   std::optional<std::vector<std::uint32_t>> last_acceptance_;
   bool acceptance_sent_ = false;
+  bool breach_logged_ = false;
+  wire::MessageWriter::ReachedOutlook reached_outlook_;  ///< reused
   BrokerSession session_;
   BrokerClientStats stats_;
 };
@@ -657,6 +697,10 @@ bool BrokerClientPort::SetBitRate(std::uint32_t bit_per_s) {
   if (bit_per_s != 0 && (bit_per_s < kMinBitrate || bit_per_s > kMaxBitrate)) return false;
   link_->SetBitRate(bit_per_s);
   return true;
+}
+
+void BrokerClientPort::AcceptanceMayHaveChanged() {
+  link_->AcceptanceMayHaveChanged();
 }
 
 std::uint32_t BrokerClientPort::BitRate() const {

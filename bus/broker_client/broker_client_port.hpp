@@ -68,6 +68,9 @@ struct BrokerClientStats {
   std::uint64_t partial_writes = 0;   ///< of those, taken only in part by the socket
   std::uint64_t reads = 0;            ///< socket reads
   std::uint64_t empty_reads = 0;      ///< of those, found nothing to read (EAGAIN)
+  /// Virtual time: frames sent by a timer confined to another identifier (Timer::Confine); 0
+  /// unless a node breaks its promise.
+  std::uint64_t confinement_breaches = 0;
 };
 
 /// A BusPort on a broker's virtual bus, over TCP or a Unix-domain socket, driven by an
@@ -120,6 +123,9 @@ class BrokerClientPort final : public BusPort {
   /// nothing changes) outside 10 000..1 000 000 bit/s.
   /// `bit_per_s` 0 returns the port to its bus's rate. Logs the change.
   bool SetBitRate(std::uint32_t bit_per_s) override;
+  /// Real time: sends the filter now if it changed. Virtual time: the node checks it after every
+  /// instant it runs (VirtualTimeClient).
+  void AcceptanceMayHaveChanged() override;
   /// The rate stated to the broker (0 = none: the bus's rate).
   std::uint32_t BitRate() const;
 

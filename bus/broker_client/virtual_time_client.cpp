@@ -55,6 +55,29 @@ bool VirtualTimeClient::Awaited(const Slot& slot) const {
   return !named && slot.port != nullptr;
 }
 
+bool VirtualTimeClient::AnyAcceptanceChanged() {
+  bool changed = false;
+  for (const std::size_t i : round_)
+    changed = (ports_[i].port != nullptr && ports_[i].port->AcceptanceChanged()) || changed;
+  return changed;
+}
+
+TimePoint VirtualTimeClient::RunUntilFilterChange(TimePoint now, TimePoint until) {
+  if (AnyAcceptanceChanged()) {
+    ++early_stops_;
+    return now;
+  }
+  while (const auto deadline = scheduler_.NextDeadline()) {
+    if (*deadline > until) break;
+    scheduler_.AdvanceTo(*deadline);  // every timer of that instant
+    if (AnyAcceptanceChanged()) {
+      ++early_stops_;
+      return scheduler_.Now();
+    }
+  }
+  return until;
+}
+
 void VirtualTimeClient::RunIfAllGranted() {
   if (running_) return;
   // The ports of the process are separate connections, read in no set order: a grant may be read
@@ -97,14 +120,26 @@ void VirtualTimeClient::RunIfAllGranted() {
   scheduler_.AdvanceTo(*now);
   for (const std::size_t i : round_)
     if (ports_[i].port != nullptr) ports_[i].port->ApplyHeld();
-  scheduler_.AdvanceTo(*until);
+  // A grant longer than a frame's travel was made for the filters the broker knows: the node stops
+  // at the first instant one of them changed (what it applied at now, or a timer), and the broker
+  // grants it again from there with the new one.
+  const TimePoint reached = *until - *now > kStopLookahead ? RunUntilFilterChange(*now, *until) : *until;
+  scheduler_.AdvanceTo(reached);
   const std::optional<TimePoint> next = scheduler_.NextDeadline();
+  scheduler_.TakeOutlook(outlook_);
+  if (scheduler_.ConfinementBreaches() > 0 && !breach_logged_) {
+    breach_logged_ = true;
+    spdlog::error(
+        "virtual time: {}: a confined timer armed or woke a timer confined otherwise (Timer::Confine): other "
+        "nodes may have been granted past what it does",
+        clock_id_);
+  }
   for (const std::size_t i : round_) {
     Slot& slot = ports_[i];
     if (slot.port == nullptr) continue;  // lost while the node ran
     slot.now.reset();
     slot.until.reset();
-    slot.port->Reached(*until, next);
+    slot.port->Reached(reached, next, outlook_);
   }
 }
 

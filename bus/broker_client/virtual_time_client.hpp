@@ -25,9 +25,13 @@ class GrantedPort {
   virtual ~GrantedPort() = default;
   /// Applies, in order, what the broker sent before its grant.
   virtual void ApplyHeld() = 0;
-  /// Tells the broker the node reached `time`, with its next deadline, and sends what the node
-  /// sent meanwhile before it.
-  virtual void Reached(TimePoint time, std::optional<TimePoint> next_deadline) = 0;
+  /// After ApplyHeld: whether what it applied changed the acceptance filter from the one the
+  /// broker knows (the node then stops at the grant's now, see VirtualTimeClient::Granted).
+  virtual bool AcceptanceChanged() { return false; }
+  /// Tells the broker the node reached `time`, with its next deadline and what its timers may send
+  /// (TimerOutlook), and sends what the node sent meanwhile before it.
+  virtual void Reached(TimePoint time, std::optional<TimePoint> next_deadline,
+                       const TimerOutlook& outlook) = 0;
 };
 
 class VirtualTimeClient {
@@ -52,11 +56,21 @@ class VirtualTimeClient {
   /// Port `index` got TimeGrant{now, until, attachments}. Runs the node once every port of
   /// `attachments` whose connection is still open (connected, or still waiting for its HelloReply)
   /// has its grant; with no `attachments` (a broker that names none), once every connected port has.
+  /// A grant that reaches further than a frame could travel (kStopLookahead) ends early, at the
+  /// first instant after which an acceptance filter changed (what was applied at `now`, or a
+  /// timer): the broker granted it as far as nothing the old filter lets through could reach it,
+  /// and grants it again from there with the new one.
   void Granted(std::size_t index, TimePoint now, TimePoint until,
                std::span<const std::uint64_t> attachments = {});
 
   /// Grants run so far (tests, statistics).
   std::uint64_t Rounds() const { return rounds_; }
+  /// Of those, ended early for a changed acceptance filter.
+  std::uint64_t EarlyStops() const { return early_stops_; }
+
+  /// The shortest time from a frame's submission to anything another node sees of it
+  /// (TimeConductor::kLookahead): a grant no longer than this never stops early.
+  static constexpr Duration kStopLookahead = std::chrono::microseconds(24);
 
  private:
   struct Slot {
@@ -67,6 +81,10 @@ class VirtualTimeClient {
     std::vector<std::uint64_t> listed;  ///< the grant's attachments
   };
   void RunIfAllGranted();
+  /// A long grant, after what was applied at `now`: runs instant by instant up to `until`, and
+  /// returns the first instant after which an acceptance filter changed (else `until`).
+  TimePoint RunUntilFilterChange(TimePoint now, TimePoint until);
+  bool AnyAcceptanceChanged();
   /// Whether the round of the grants held so far waits for `slot` (open, not granted yet).
   bool Awaited(const Slot& slot) const;
 
@@ -76,8 +94,11 @@ class VirtualTimeClient {
   std::vector<std::size_t> round_;  ///< the ports a run serves (reused)
   std::uint64_t next_attachment_ = 1;
   std::uint64_t rounds_ = 0;
+  std::uint64_t early_stops_ = 0;
+  TimerOutlook outlook_;  ///< reused
   bool running_ = false;  ///< a port failing while the node runs must not start another run
   bool mismatch_logged_ = false;
+  bool breach_logged_ = false;
 };
 
 }  // namespace canfleet

@@ -143,12 +143,22 @@ void MessageWriter::AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns,
   });
 }
 
-void MessageWriter::AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns) {
+void MessageWriter::AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns,
+                                   const ReachedOutlook* outlook) {
   AppendProto([&](Envelope& e) {
     auto* reached = e.mutable_time_reached();
     reached->set_time_ns(time_ns);
     reached->set_has_deadline(next_deadline_ns.has_value());
     reached->set_next_deadline_ns(next_deadline_ns.value_or(0));
+    if (outlook == nullptr) return;
+    reached->set_has_outlook(true);
+    reached->set_has_any(outlook->any_ns.has_value());
+    reached->set_any_ns(outlook->any_ns.value_or(0));
+    for (const auto& [id, deadline] : outlook->confined) {
+      auto* c = reached->add_confined();
+      c->set_id(id);
+      c->set_deadline_ns(deadline);
+    }
   });
 }
 

@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "bus/wire/byte_buffer.hpp"
@@ -96,8 +97,15 @@ class MessageWriter {
   /// the node process's connections the round grants (TimeGrant.attachments).
   void AddTimeGrant(std::int64_t now_ns, std::int64_t until_ns,
                     std::span<const std::uint64_t> attachments = {});
-  /// TimeReached{time_ns, next deadline} (virtual time, node -> broker); no deadline: nullopt.
-  void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns);
+  /// What a node's timers may send (TimeReached's outlook, per-node lookahead), in nanoseconds.
+  struct ReachedOutlook {
+    std::optional<std::int64_t> any_ns;                            ///< any identifier from then on
+    std::vector<std::pair<std::uint32_t, std::int64_t>> confined;  ///< (11-bit identifier, deadline)
+  };
+  /// TimeReached{time_ns, next deadline, outlook} (virtual time, node -> broker); no deadline:
+  /// nullopt; no outlook: nullptr (the broker takes every timer to send anything).
+  void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns,
+                      const ReachedOutlook* outlook = nullptr);
   /// Acceptance{ids} (virtual time, node -> broker); nullopt: every frame.
   void AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids);
   /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write

@@ -27,18 +27,25 @@ class DevicePort final : public BusPort {
   bool Send(const CanFrame& frame) override;
   ControllerState State() const override { return port_.State(); }
   bool SetBitRate(std::uint32_t bit_per_s) override { return port_.SetBitRate(bit_per_s); }
+  void AcceptanceMayHaveChanged() override { port_.AcceptanceMayHaveChanged(); }
 
   /// A frame the device sends itself (not muted: the device decides when it speaks).
   bool SendFromDevice(const CanFrame& frame) { return port_.Send(frame); }
   void SetMuted(bool muted) { muted_ = muted; }
   bool Muted() const { return muted_; }
-  void ObserveFrames(FrameObserver observer) { observer_ = std::move(observer); }
-  /// The device watches every frame (a power supply wakes on any of them, §1.2.2).
-  bool Observed() const { return static_cast<bool>(observer_); }
+  /// `wanted`: whether the observer needs every frame now (empty: always). A frame the stack does
+  /// not listen to then still reaches the port (its acceptance filter lets every frame through).
+  void ObserveFrames(FrameObserver observer, std::function<bool()> wanted = {}) {
+    observer_ = std::move(observer);
+    wanted_ = std::move(wanted);
+  }
+  /// The device watches every frame now (a power supply asleep wakes on any of them, §1.2.2).
+  bool Observed() const { return observer_ && (!wanted_ || wanted_()); }
 
  private:
   BusPort& port_;
   FrameObserver observer_;
+  std::function<bool()> wanted_;
   bool muted_ = false;
 };
 

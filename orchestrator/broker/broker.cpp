@@ -93,6 +93,10 @@ std::optional<PortId> Broker::NewestPortNamed(std::string_view bus, std::string_
   return found;
 }
 
+void Broker::Outlook(std::string_view bus, BusOutlook& out) const {
+  FindBus(bus).Outlook(out);
+}
+
 std::vector<std::string> Broker::Buses() const {
   std::vector<std::string> names;
   for (const auto& bus : buses_)

@@ -28,6 +28,21 @@ class VirtualBus;
 struct Port;
 }  // namespace detail
 
+/// What a bus can still bring its receivers by itself (lock-step virtual time, issue 34:
+/// TimeConductor grants each node process as far as nothing it listens to can reach it).
+struct BusOutlook {
+  /// No transfer can fail and no controller can change state by itself: every attached port runs
+  /// at the bus's rate and is error-active (or bus-off with no recovery due), none babbles, at
+  /// least two can acknowledge, and no fault rule corrupts. Then a port receives only the frames
+  /// others send, and nothing of its own ones.
+  bool calm = false;
+  std::optional<TimePoint> next_event;  ///< the bus's next event (a transfer ends, ...)
+  /// Frames on the bus (in flight, queued, delayed by a fault). Each reaches its receivers at
+  /// the next event or later.
+  std::vector<CanFrame> frames;
+  std::size_t transmitters = 0;  ///< attached ports that may transmit (not listen-only)
+};
+
 /// Paced buses (the default) model the wire on the bus's own time line:
 /// - the head frames of all ports' TX queues (FIFO per port) are arbitrated by ArbitrationKey;
 ///   a frame joins an arbitration when it was submitted by the arbitration's start, so frames
@@ -98,6 +113,11 @@ class Broker {
   std::optional<PortId> NewestPortNamed(std::string_view bus, std::string_view name) const;
   /// Bus names in the order they were added.
   std::vector<std::string> Buses() const;
+  /// Fills `out` (reusing its storage). Throws std::invalid_argument on an unknown bus.
+  void Outlook(std::string_view bus, BusOutlook& out) const;
+  /// The confinement (Timer::Confine) of every bus's timer: its callbacks only run the bus, whose
+  /// effects Outlook describes.
+  static constexpr std::uint32_t kBusTimerKey = 0xFFFF'FFFE;
 
  private:
   struct PortRef {

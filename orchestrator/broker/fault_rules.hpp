@@ -32,6 +32,12 @@ class FaultRules {
   std::vector<RuleStatus> List(BusTime now) const;
 
   bool Empty() const { return rules_.empty(); }
+  /// Some rule may destroy a transfer (kCorrupt): then errors and controller events may follow.
+  bool MayCorrupt() const {
+    for (const Rule& rule : rules_)
+      if (rule.spec.action == RuleAction::kCorrupt) return true;
+    return false;
+  }
 
   /// At start of frame: true when a corrupt rule fires on this transfer attempt.
   bool CorruptAttempt(PortId source, const CanFrame& frame, BusTime start);

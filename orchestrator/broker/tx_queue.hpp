@@ -28,6 +28,16 @@ class TxQueue {
   std::size_t size() const { return size_; }
   std::size_t capacity() const { return slots_.size(); }
 
+  /// Calls `f` with each queued frame, oldest first.
+  template <class F>
+  void ForEach(F&& f) const {
+    std::size_t i = head_;
+    for (std::size_t n = 0; n < size_; ++n) {
+      f(slots_[i]);
+      if (++i == slots_.size()) i = 0;
+    }
+  }
+
   QueuedFrame& front() { return slots_[head_]; }
   const QueuedFrame& front() const { return slots_[head_]; }
 

@@ -94,6 +94,32 @@ VirtualBus::VirtualBus(Scheduler& scheduler, BusConfig config)
   delayed_.reserve(256);
   round_.frames_.reserve(256);
   round_.id_ = NextRoundId();
+  timer_.Confine(Broker::kBusTimerKey);
+}
+
+void VirtualBus::Outlook(BusOutlook& out) const {
+  out.calm = config_.paced && !rules_.MayCorrupt();
+  out.next_event.reset();
+  if (const auto next = NextEvent()) out.next_event = TimePoint(*next);
+  out.frames.clear();
+  out.transmitters = 0;
+  std::size_t acknowledgers = 0;
+  for (const auto& p : ports_) {
+    if (p->detached) continue;
+    const ControllerState state = p->controller.State();
+    if (p->bitrate != config_.bitrate || state == ControllerState::kErrorPassive || p->recover_at ||
+        p->babbling)
+      out.calm = false;
+    if (!p->options.listen_only) {
+      ++out.transmitters;
+      if (state != ControllerState::kBusOff) ++acknowledgers;
+    }
+    p->queue.ForEach([&](const QueuedFrame& q) { out.frames.push_back(q.frame); });
+  }
+  if (acknowledgers < 2) out.calm = false;  // a lone transmitter sees ACK errors
+  if (in_flight_) out.frames.push_back(in_flight_->entry.frame);
+  for (const Delayed& d : delayed_)
+    out.frames.push_back(d.frame);
 }
 
 // ---------------------------------------------------------------------------------------------

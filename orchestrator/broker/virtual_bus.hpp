@@ -20,6 +20,7 @@
 #include "bus/physics/fault_confinement.hpp"
 #include "bus/physics/wire_model.hpp"
 #include "clock/scheduler.hpp"
+#include "orchestrator/broker/broker.hpp"
 #include "orchestrator/broker/bus_config.hpp"
 #include "orchestrator/broker/fault_rules.hpp"
 #include "orchestrator/broker/fault_stage.hpp"
@@ -112,6 +113,7 @@ class VirtualBus {
   Port& PortOnBus(PortId id) const;
 
   FaultStage& Faults() { return faults_; }
+  void Outlook(BusOutlook& out) const;
   BusStats Stats(std::size_t top_ids) const;
   PortStats StatsOf(const Port& port) const;
   /// The attached ports, in attach order.

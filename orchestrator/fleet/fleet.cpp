@@ -112,6 +112,11 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
         [this, bus](const CanFrame& frame, BusTime) { tracker_.Observe(bus, frame, scheduler_.Now()); });
     sdo_[bus] = std::make_unique<SdoQueue>(*master, scheduler_);
     masters_[bus] = std::move(master);
+    // Virtual time: the master answers at once what it hears (a boot-up, an SDO answer); per-node
+    // lookahead must know (TimeConductor::AddReactor).
+    if (options_.conductor != nullptr)
+      reactors_.push_back(
+          options_.conductor->AddReactor(bus, [this, bus] { return sdo_.at(bus)->Pending() > 0; }));
   }
   tracker_.OnBootUp([this](const std::string& bus, std::uint8_t id) { OnBootUp(bus, id); });
   tracker_.OnEmcy([this](const std::string& bus, std::uint8_t id, const SeenEmcy& emcy) {
@@ -163,7 +168,11 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
       std::move(external_ports));
 }
 
-Fleet::~Fleet() = default;
+Fleet::~Fleet() {
+  if (options_.conductor != nullptr)
+    for (const std::uint64_t id : reactors_)
+      options_.conductor->RemoveReactor(id);
+}
 
 void Fleet::Start() {
   spdlog::info("topology {}: {} bus(es), {} node(s)", options_.topology.name(), masters_.size(),

@@ -195,8 +195,9 @@ class Fleet final : public control::ControlHandler, public scenario::FleetProbe 
   WallTime wall_origin_;
 
   std::vector<FleetNode> nodes_;
-  std::map<std::string, std::unique_ptr<MasterPort>> masters_;          ///< by bus
-  std::map<std::string, std::unique_ptr<SdoQueue>> sdo_;                ///< by bus
+  std::map<std::string, std::unique_ptr<MasterPort>> masters_;  ///< by bus
+  std::map<std::string, std::unique_ptr<SdoQueue>> sdo_;        ///< by bus
+  std::vector<std::uint64_t> reactors_;  ///< the masters, as the time conductor knows them
   std::map<std::pair<std::string, std::size_t>, PortRuntime> runtime_;  ///< (node, port)
   NodeTracker tracker_;
   Supervisor supervisor_;

@@ -14,6 +14,8 @@ host::HostTime FleetTime(const topology::Topology& spec, const TimeOverride& ove
   else
     throw std::invalid_argument("--time " + override.mode + ": real or virtual");
   time.conductor.speed = override.speed ? *override.speed : spec.time().speed();
+  if (override.global_lookahead)
+    time.conductor.lookahead = transport::TimeConductorOptions::Lookahead::kGlobal;
   if (time.conductor.speed < 0 || !std::isfinite(time.conductor.speed))
     throw std::invalid_argument("speed must be 0 (max) or a positive factor");
   return time;

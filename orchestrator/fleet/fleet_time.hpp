@@ -18,8 +18,9 @@
 namespace canfleet::fleet {
 
 struct TimeOverride {
-  std::string mode;             ///< "real", "virtual", or empty: the topology's
-  std::optional<double> speed;  ///< simulated seconds per real second; 0 = max; unset: the topology's
+  std::string mode;               ///< "real", "virtual", or empty: the topology's
+  std::optional<double> speed;    ///< simulated seconds per real second; 0 = max; unset: the topology's
+  bool global_lookahead = false;  ///< TimeConductorOptions::Lookahead::kGlobal (benchmarks, comparisons)
 };
 
 /// The host's time for `spec` with `override`. Throws std::invalid_argument on a bad speed.

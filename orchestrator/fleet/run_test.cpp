@@ -233,8 +233,9 @@ class FileRun {
       report_.factor = conductor->Factor();
       const auto& st = conductor->Stats();
       spdlog::info(
-          "virtual time: {} rounds, {} grants, {} frames put on the buses, {} evictions, factor {:.1f}",
-          st.rounds, st.grants, st.frames, st.evictions, report_.factor);
+          "virtual time: {} rounds, {} grants, {} frames put on the buses, {} evictions, {} early stops, {} "
+          "causality errors, factor {:.1f}",
+          st.rounds, st.grants, st.frames, st.evictions, st.early_stops, st.causality_errors, report_.factor);
     }
 
     report_.results = fleet->ScenarioResults();

@@ -178,17 +178,30 @@ void NodeSession::Handle(const wire::Message& m) {
       const auto next = reached.has_deadline()
                             ? std::optional(TimePoint(Duration(reached.next_deadline_ns())))
                             : std::nullopt;
-      if (!granted_ || !options_.time_conductor->Reached(*this, TimePoint(Duration(reached.time_ns())), next))
+      const SendOutlook* outlook = nullptr;
+      if (reached.has_outlook()) {
+        outlook_.any =
+            reached.has_any() ? std::optional(TimePoint(Duration(reached.any_ns()))) : std::nullopt;
+        outlook_.confined.clear();
+        for (const auto& c : reached.confined()) {
+          const TimePoint deadline(Duration(c.deadline_ns()));
+          if (c.id() <= 0x7FF)
+            outlook_.confined.push_back({c.id(), deadline});
+          else  // not an 11-bit identifier: taken as anything
+            outlook_.any = std::min(outlook_.any.value_or(deadline), deadline);
+        }
+        outlook = &outlook_;
+      }
+      if (!granted_ ||
+          !options_.time_conductor->Reached(*this, TimePoint(Duration(reached.time_ns())), next, outlook))
         ProtocolError("TimeReached at " + std::to_string(reached.time_ns()) +
                       " ns without a grant to that time");
       return;
     }
     case MessageType::kAcceptance: {
       const auto& acceptance = m.envelope.acceptance();
-      accept_all_ = acceptance.all();
-      accepted_.reset();
-      for (const std::uint32_t id : acceptance.ids())
-        accepted_.set(id);
+      acceptance_.Set(acceptance.all(),
+                      {acceptance.ids().data(), static_cast<std::size_t>(acceptance.ids().size())});
       return;
     }
     case MessageType::kTimeGrant:
@@ -454,7 +467,7 @@ void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
     Overflow(frames.size());
     return;
   }
-  if (!accept_all_) {
+  if (!acceptance_.All()) {
     // What the node does not listen to does not wake it (its acceptance filter).
     std::size_t accepted = 0;
     for (const broker::TimedFrame& f : frames) {
@@ -479,7 +492,7 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
-  if (!accept_all_) {
+  if (!acceptance_.All()) {
     // What the node does not listen to does not wake it (its acceptance filter). When it takes
     // every frame of the round, they go out as without a filter (gathered, below).
     const std::span<const broker::TimedFrame> all = round.Frames();

@@ -6,7 +6,6 @@
 
 #include <sys/uio.h>
 #include <array>
-#include <bitset>
 
 #include <asio/generic/stream_protocol.hpp>
 #include <asio/steady_timer.hpp>
@@ -85,6 +84,7 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   void SendGrant(TimePoint now, TimePoint until, std::span<const std::uint64_t> attachments) override;
   void Evict(const std::string& reason) override;
   const std::string& Label() const override { return label_; }
+  const Acceptance& Accepting() const override { return acceptance_; }
 
  private:
   /// Attaches the port and answers the Hello (between rounds in virtual time).
@@ -143,14 +143,12 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   bool hello_seen_ = false;  ///< a Hello arrived (in virtual time it is accepted between rounds)
   bool granted_ = false;     ///< a node in virtual time: the conductor grants its time
   bool driven_ = false;      ///< a participant of the process that drives time (Hello.driven)
-  /// The node's acceptance filter (Acceptance), in real and virtual time; until it sends one,
-  /// every frame.
-  bool accept_all_ = true;
-  std::bitset<2048> accepted_;
+  /// The node's acceptance filter (wire::Acceptance), in real and virtual time; until it sends
+  /// one, every frame.
+  Acceptance acceptance_;
   /// Whether `frame` passes the filter (extended and error frames always do).
-  bool Accepts(const CanFrame& frame) const {
-    return accept_all_ || frame.extended() || frame.error() || accepted_.test(frame.id & 0x7FF);
-  }
+  bool Accepts(const CanFrame& frame) const { return acceptance_.Accepts(frame); }
+  SendOutlook outlook_;  ///< of the last TimeReached (reused)
 
   wire::StreamDecoder decoder_;
   wire::Message message_;

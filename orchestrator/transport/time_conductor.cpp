@@ -28,7 +28,28 @@ TimeConductor::TimeConductor(asio::io_context& io, GrantedScheduler& scheduler, 
       options_(options),
       grace_timer_(io),
       pace_timer_(io),
-      join_timer_(io) {}
+      join_timer_(io) {
+  std::vector<std::uint32_t> boot_ups, answers, both;
+  for (std::uint32_t id = 1; id <= 0x7F; ++id) {
+    boot_ups.push_back(0x700 + id);
+    answers.push_back(0x580 + id);
+  }
+  both = boot_ups;
+  both.insert(both.end(), answers.begin(), answers.end());
+  boot_ups_.Set(false, boot_ups);
+  answers_.Set(false, answers);
+  boot_ups_and_answers_.Set(false, both);
+  nothing_.Set(false, {});
+}
+
+std::uint64_t TimeConductor::AddReactor(std::string bus, std::function<bool()> busy) {
+  reactors_.push_back({next_reactor_, std::move(bus), std::move(busy), {}});
+  return next_reactor_++;
+}
+
+void TimeConductor::RemoveReactor(std::uint64_t id) {
+  std::erase_if(reactors_, [id](const Reactor& r) { return r.id == id; });
+}
 
 TimeConductor::~TimeConductor() {
   alive_.reset();
@@ -43,7 +64,8 @@ void TimeConductor::Join(GrantedSession& session, const std::string& clock_id, s
   p.clock_id = clock_id;
   p.sessions.push_back(&session);
   p.ports = std::max<std::size_t>(clock_ports, 1);
-  p.pending = true;  // it may act now (boot-up): it takes part in the next round
+  p.reached = std::max(p.reached, Now());
+  MarkPending(p);  // it may act now (boot-up): it takes part in the next round
   sessions_[&session] = SessionState{&p, attachment, false};
   spdlog::debug("virtual time: {} joined at {} ({})", session.Label(), TimeText(Now()), clock_id);
   // A process counts once every port it attaches has joined: it powers on when its last port is
@@ -87,6 +109,7 @@ void TimeConductor::Prune() {
     }
     const Participant* gone = &it->second;
     std::erase_if(submissions_, [gone](const Submission& s) { return s.participant == gone; });
+    if (gone->pending) --pending_count_;
     it = participants_.erase(it);
   }
 }
@@ -94,8 +117,26 @@ void TimeConductor::Prune() {
 void TimeConductor::Pending(GrantedSession& session) {
   auto it = sessions_.find(&session);
   if (it == sessions_.end()) return;
-  it->second.participant->pending = true;
+  MarkPending(*it->second.participant);
   Kick();
+}
+
+void TimeConductor::MarkPending(Participant& p) {
+  if (Now() < p.reached) {
+    // Per-node lookahead granted it past this: the premise of its horizon did not hold (a node's
+    // timer sent what it had not said). It gets it at its own time, later than on the bus.
+    ++stats_.causality_errors;
+    if (!causality_logged_) {
+      causality_logged_ = true;
+      spdlog::error(
+          "virtual time: something reached {} at {}, which had been granted to {} (a broken premise of "
+          "per-node lookahead; grant_horizon.hpp)",
+          p.clock_id, TimeText(Now()), TimeText(p.reached));
+    }
+  }
+  if (p.pending) return;
+  p.pending = true;
+  ++pending_count_;
 }
 
 void TimeConductor::Submit(GrantedSession& session, broker::PortId port,
@@ -108,17 +149,30 @@ void TimeConductor::Submit(GrantedSession& session, broker::PortId port,
   }
 }
 
-bool TimeConductor::Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline) {
+bool TimeConductor::Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline,
+                            const SendOutlook* outlook) {
   auto it = sessions_.find(&session);
-  if (it == sessions_.end() || !it->second.granted || !round_open_ || time != round_until_) return false;
-  it->second.granted = false;
-  it->second.participant->next = next_deadline;
+  if (it == sessions_.end() || !it->second.granted || !round_open_) return false;
+  SessionState& state = it->second;
+  // A long grant may end early, at the instant after which the node's filter changed.
+  const bool early = state.until - state.now > kLookahead && time >= state.now && time < state.until;
+  if (time != state.until && !early) return false;
+  state.granted = false;
+  Participant& p = *state.participant;
+  if (early && time != state.until) ++stats_.early_stops;
+  p.reached = std::max(p.reached, time);
+  p.next = next_deadline;
+  p.has_outlook = outlook != nullptr;
+  if (outlook != nullptr) {
+    p.outlook.any = outlook->any;
+    p.outlook.confined.assign(outlook->confined.begin(), outlook->confined.end());
+  }
   if (--outstanding_ == 0 && !granting_) CloseRound();  // while granting, OpenRound closes it
   return true;
 }
 
 void TimeConductor::AtBoundary(std::function<void()> action) {
-  if (!round_open_ && !advancing_) {
+  if (!round_open_ && !advancing_ && CaughtUp()) {
     action();
     Kick();
     return;
@@ -242,7 +296,7 @@ void TimeConductor::RunBoundaryActions() {
 void TimeConductor::StartRound() {
   for (int i = 0; i < kRoundsPerTurn; ++i) {
     if (round_open_ || advancing_) return;
-    RunBoundaryActions();
+    if (CaughtUp()) RunBoundaryActions();  // else when the bus has caught up with the processes
     if (!OpenRound()) return;
     if (round_open_) return;  // waiting for TimeReached; CloseRound kicks the next one
   }
@@ -253,6 +307,10 @@ bool TimeConductor::OpenRound() {
   const TimePoint now = Now();
   // Broker timers armed at the current time (a frame submitted between rounds) run first.
   if (auto b = scheduler_.NextDeadline(); b && *b <= now) AdvanceBroker(now);
+  // Per-node lookahead; also to bring the bus up to processes granted ahead of it before time is
+  // driven or paced with one G for all.
+  if (PerNode() || !CaughtUp()) return OpenPerNodeRound(now);
+  per_node_round_ = false;
 
   std::optional<TimePoint> node_next;
   for (const auto& [id, p] : participants_) {
@@ -306,12 +364,160 @@ bool TimeConductor::OpenRound() {
   outstanding_ = 0;
   for (auto& [id, p] : participants_) {
     if (!p.pending && !(p.next && *p.next <= until)) continue;
+    if (p.pending) --pending_count_;
     p.pending = false;
     for (GrantedSession* s : p.sessions) {
-      sessions_[s].granted = true;
+      SessionState& state = sessions_[s];
+      state.granted = true;
+      state.now = now;
+      state.until = until;
       ++outstanding_;
     }
   }
+  SendGrants();
+  if (outstanding_ == 0) {
+    CloseRound();
+    return true;
+  }
+  // One OS timer for many rounds: armed only when none is pending (re-arming it for every round
+  // of a few microseconds cost two timerfd syscalls each); it checks the open round's age.
+  round_opened_ = std::chrono::steady_clock::now();
+  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
+  return true;
+}
+
+TimePoint TimeConductor::Frontier() const {
+  TimePoint furthest = Now();
+  for (const auto& [id, p] : participants_)
+    furthest = std::max(furthest, p.reached);
+  return furthest;
+}
+
+void TimeConductor::ComputeHorizons(TimePoint now, std::optional<TimePoint> cap) {
+  order_.clear();
+  nodes_.clear();
+  std::fill(bus_sessions_.begin(), bus_sessions_.end(), 0);
+  const auto bus_index = [this](const std::string& name) {
+    auto it = std::ranges::find(bus_names_, name);
+    if (it == bus_names_.end()) {
+      bus_names_ = broker_.Buses();  // a bus added since
+      bus_sessions_.resize(bus_names_.size(), 0);
+      it = std::ranges::find(bus_names_, name);
+    }
+    return static_cast<std::size_t>(it - bus_names_.begin());
+  };
+  for (auto& [id, p] : participants_) {
+    p.ports_of_round.clear();
+    for (const GrantedSession* session : p.sessions) {
+      const std::size_t b = bus_index(session->Bus());
+      if (b >= bus_names_.size()) continue;  // not a bus of this broker (cannot happen)
+      p.ports_of_round.push_back({b, &session->Accepting()});
+      ++bus_sessions_[b];
+    }
+    order_.push_back(&p);
+  }
+  for (Reactor& r : reactors_) {
+    r.ports.clear();
+    const std::size_t b = bus_index(r.bus);
+    if (b >= bus_names_.size()) continue;
+    const bool busy = r.busy && r.busy();
+    r.ports.push_back({b, busy ? &boot_ups_and_answers_ : &boot_ups_, busy ? &answers_ : &nothing_, true});
+    ++bus_sessions_[b];
+  }
+  buses_.resize(bus_names_.size());
+  for (std::size_t b = 0; b < bus_names_.size(); ++b) {
+    broker_.Outlook(bus_names_[b], bus_outlook_);
+    HorizonBus& bus = buses_[b];
+    // Calm only if every port that may transmit is a node process's: anything else (a tool, the
+    // fleet's own SDO client) may answer what it hears at once, which the horizons do not model.
+    bus.calm = bus_outlook_.calm && bus_outlook_.transmitters == bus_sessions_[b];
+    bus.next_event = bus_outlook_.next_event;
+    bus.pending_keys.clear();
+    bus.boot_up = false;
+    for (const CanFrame& f : bus_outlook_.frames) {
+      bus.pending_keys.push_back(Acceptance::KeyOf(f));
+      bus.boot_up = bus.boot_up || (!f.extended() && !f.remote() && f.id > 0x700 && f.id <= 0x77F &&
+                                    f.dlc == 1 && (f.data[0] & 0x7F) == 0);
+    }
+  }
+  for (const Participant* p : order_) {
+    HorizonNode& node = nodes_.emplace_back();
+    node.pending = p->pending;
+    node.next = p->next;
+    node.any = p->has_outlook ? p->outlook.any : p->next;
+    if (p->has_outlook) node.confined = p->outlook.confined;
+    node.ports = p->ports_of_round;
+  }
+  for (const Reactor& r : reactors_) {
+    HorizonNode& node = nodes_.emplace_back();  // no timers of its own: it answers what it hears
+    node.ports = r.ports;
+  }
+  horizons_.Compute(now, kLookahead, cap, buses_, nodes_);
+}
+
+bool TimeConductor::OpenPerNodeRound(TimePoint now) {
+  const bool catching_up = !CaughtUp();
+  // Held, or an outside input waiting: time stands still once the bus has caught up with every
+  // process (the input is applied then, at StartRound).
+  if (((holds_ > 0 || !boundary_.empty()) && !catching_up) || participants_.empty()) {
+    run_wall_start_.reset();
+    return false;
+  }
+  // What the broker does on its own (a scenario step, a fault's timer) may reach anybody; a bus's
+  // own timer is described by its outlook.
+  scheduler_.TakeOutlook(broker_timers_);
+  TimePoint cap = now + kMaxGrant;
+  if (broker_timers_.unconfined) cap = std::min(cap, *broker_timers_.unconfined);
+  if (holds_ > 0 || !boundary_.empty() || !PerNode()) cap = std::min(cap, Frontier());
+  ComputeHorizons(now, cap);
+
+  bool any_due = pending_count_ > 0;
+  for (const Participant* p : order_)
+    any_due = any_due || p->next.has_value();
+  if (!any_due && !scheduler_.NextDeadline()) {
+    run_wall_start_.reset();  // nothing will ever happen: time stands still
+    return false;
+  }
+  const auto wall_now = std::chrono::steady_clock::now();
+  if (!run_wall_start_) {
+    run_wall_start_ = wall_now;
+    run_sim_start_ = now;
+    last_wall_ = wall_now;
+  }
+
+  per_node_round_ = true;
+  round_open_ = true;
+  outstanding_ = 0;
+  for (std::size_t i = 0; i < order_.size(); ++i) {
+    Participant& p = *order_[i];
+    const TimePoint horizon = std::min(horizons_.Of(i).value_or(cap), cap);
+    if (!p.pending && !(p.next && *p.next <= horizon)) continue;  // nothing to do before its horizon
+    TimePoint until = horizon <= now ? now + Duration(1) : horizon;
+    if (until <= p.reached) {
+      if (!p.pending) continue;  // it is there already
+      until = p.reached;         // a causality error, counted when it became pending
+    }
+    if (p.pending) --pending_count_;
+    p.pending = false;
+    for (GrantedSession* session : p.sessions) {
+      SessionState& state = sessions_[session];
+      state.granted = true;
+      state.now = now;
+      state.until = until;
+      ++outstanding_;
+    }
+  }
+  SendGrants();
+  if (outstanding_ == 0) {
+    CloseRound();
+    return true;
+  }
+  round_opened_ = std::chrono::steady_clock::now();
+  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
+  return true;
+}
+
+void TimeConductor::SendGrants() {
   // Granted after marking: a session failing in SendGrant leaves with its grant counted.
   std::vector<GrantedSession*> granted;
   for (auto& [s, state] : sessions_)
@@ -333,18 +539,9 @@ bool TimeConductor::OpenRound() {
     attachments_.clear();
     for (const GrantedSession* sibling : it->second.participant->sessions)
       if (const std::uint64_t a = sessions_.at(sibling).attachment; a != 0) attachments_.push_back(a);
-    s->SendGrant(now, until, attachments_);
+    s->SendGrant(it->second.now, it->second.until, attachments_);
   }
   granting_ = false;
-  if (outstanding_ == 0) {
-    CloseRound();
-    return true;
-  }
-  // One OS timer for many rounds: armed only when none is pending (re-arming it for every round
-  // of a few microseconds cost two timerfd syscalls each); it checks the open round's age.
-  round_opened_ = std::chrono::steady_clock::now();
-  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
-  return true;
 }
 
 void TimeConductor::ArmGrace(std::chrono::steady_clock::time_point at) {
@@ -365,7 +562,20 @@ void TimeConductor::ArmGrace(std::chrono::steady_clock::time_point at) {
 
 void TimeConductor::CloseRound() {
   round_open_ = false;
-  AdvanceBroker(round_until_);
+  if (per_node_round_) {
+    // The bus runs up to the earliest deadline of any process: until then none sends anything it
+    // has not sent already, unless something reaches it first (then the bus stops there).
+    TimePoint target = Now() + kMaxGrant;
+    for (const auto& [id, p] : participants_) {
+      if (p.pending) target = Now();
+      if (p.next) target = std::min(target, *p.next);
+    }
+    if (holds_ > 0 || !boundary_.empty() || !PerNode())
+      target = std::min(target, std::max(Frontier(), Now()));
+    AdvanceBrokerUntilInput(std::max(target, Now()));
+  } else {
+    AdvanceBroker(round_until_);
+  }
   ++stats_.rounds;
   const auto wall_now = std::chrono::steady_clock::now();
   stats_.wall += wall_now - last_wall_;
@@ -398,6 +608,48 @@ void TimeConductor::AdvanceBroker(TimePoint until) {
   scheduler_.AdvanceTo(until);
   stats_.simulated += Now() - start;
   Prune();  // processes that left meanwhile
+}
+
+void TimeConductor::AdvanceBrokerUntilInput(TimePoint until) {
+  advancing_ = true;
+  struct Done {
+    bool& flag;
+    ~Done() { flag = false; }
+  } done{advancing_};
+  const TimePoint start = Now();
+  const int holds_at_start = holds_;
+  std::stable_sort(submissions_.begin(), submissions_.end(), [](const Submission& a, const Submission& b) {
+    if (a.time != b.time) return a.time < b.time;
+    if (a.participant != b.participant) return a.participant->clock_id < b.participant->clock_id;
+    if (*a.bus_key != *b.bus_key) return *a.bus_key < *b.bus_key;
+    return a.sequence < b.sequence;
+  });
+  // Instant by instant, in the order AdvanceBroker takes them (each frame after the timers due by
+  // its time), so that the bus is the same whichever way it was granted.
+  std::size_t taken = 0;
+  bool stopped = false;
+  for (;;) {
+    std::optional<TimePoint> instant = scheduler_.NextDeadline();
+    if (taken < submissions_.size() && (!instant || submissions_[taken].time < *instant))
+      instant = std::max(submissions_[taken].time, Now());
+    if (!instant || *instant > until) break;
+    if (*instant > Now() && (pending_count_ > 0 || holds_ > holds_at_start)) {
+      stopped = true;  // something reached a process (or a hold began) at Now(): it acts there first
+      break;
+    }
+    for (; taken < submissions_.size() && submissions_[taken].time <= *instant; ++taken) {
+      const Submission& s = submissions_[taken];
+      if (s.time < Now()) ++stats_.late_frames;
+      scheduler_.AdvanceTo(s.time);
+      broker_.Submit(s.port, s.frame);
+      ++stats_.frames;
+    }
+    scheduler_.AdvanceTo(*instant);
+  }
+  submissions_.erase(submissions_.begin(), submissions_.begin() + static_cast<std::ptrdiff_t>(taken));
+  if (!stopped && pending_count_ == 0 && holds_ <= holds_at_start) scheduler_.AdvanceTo(until);
+  stats_.simulated += Now() - start;
+  Prune();
 }
 
 void TimeConductor::OnGraceExpired() {

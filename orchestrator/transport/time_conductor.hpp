@@ -23,6 +23,18 @@
 /// Outside inputs (control requests, new connections) are applied between rounds: at T, never
 /// inside a round. Time stands still while no node process takes part, and while Hold()s last.
 ///
+/// Per-node lookahead (issue 34, the default when time runs free): instead of one G for all, each
+/// node process is granted as far as nothing it listens to can reach it (grant_horizon.hpp: its
+/// acceptance filters, what the others' timers may send, the frames on the buses, the broker's own
+/// timers), and the broker runs the buses up to the earliest deadline of any process, stopping at
+/// the first instant something reaches a process. Processes then stand at different times, all at
+/// or after the bus's: an outside input waits until the bus has caught up with the furthest of them
+/// (the frontier), and is applied there. A bus that is not calm (a fault may corrupt, a controller
+/// is error-passive...) holds each of its processes to the earliest timer on it, as above. A process
+/// whose filter changes stops at the grant's now (virtual_time_client.hpp). Driven (a test steps
+/// time) or paced (speed > 0), the conductor grants as above with one G for all
+/// (TimeConductorOptions::lookahead).
+///
 /// Threading: the thread of the broker's event loop, like the broker.
 
 #include <asio/io_context.hpp>
@@ -42,6 +54,8 @@
 #include "bus/wire/frame_record.hpp"
 #include "clock/granted_scheduler.hpp"
 #include "orchestrator/broker/broker.hpp"
+#include "orchestrator/transport/acceptance.hpp"
+#include "orchestrator/transport/grant_horizon.hpp"
 
 namespace canfleet::transport {
 
@@ -59,22 +73,40 @@ class GrantedSession {
   virtual const std::string& Label() const = 0;
   /// The bus it is attached to (orders simultaneous frames of one process's ports).
   virtual const std::string& Bus() const = 0;
+  /// What the node listens to on it (wire::Acceptance); every frame until it says.
+  virtual const Acceptance& Accepting() const {
+    static const Acceptance every;
+    return every;
+  }
+};
+
+/// What a node process's timers may send (TimeReached's outlook, grant_horizon.hpp).
+struct SendOutlook {
+  std::optional<TimePoint> any;  ///< any identifier from then on; nullopt: no timer that may
+  std::vector<ConfinedSend> confined;
 };
 
 struct TimeConductorOptions {
   /// Simulated seconds per real second; 0: as fast as the processes go ("--speed max").
   double speed = 0;
+  /// How far node processes are granted: each its own way (per-node lookahead, issue 34), or all
+  /// to one G (the lookahead of the earliest; what driven and paced time always use).
+  enum class Lookahead : std::uint8_t { kPerNode, kGlobal } lookahead = Lookahead::kPerNode;
   /// A node process that has not answered a grant within this (real time) is treated as
   /// disconnected, so a killed or stalled process does not stop the fleet's time.
   std::chrono::milliseconds grace{10'000};
 };
 
 struct TimeConductorStats {
-  std::uint64_t rounds = 0;               ///< rounds run (with or without node processes)
-  std::uint64_t grants = 0;               ///< TimeGrants sent
-  std::uint64_t frames = 0;               ///< node frames put on the buses at their times
-  std::uint64_t evictions = 0;            ///< sessions closed for not answering in time
-  std::uint64_t late_frames = 0;          ///< frames stamped before the bus's time (applied at it)
+  std::uint64_t rounds = 0;       ///< rounds run (with or without node processes)
+  std::uint64_t grants = 0;       ///< TimeGrants sent
+  std::uint64_t frames = 0;       ///< node frames put on the buses at their times
+  std::uint64_t evictions = 0;    ///< sessions closed for not answering in time
+  std::uint64_t late_frames = 0;  ///< frames stamped before the bus's time (applied at it)
+  std::uint64_t early_stops = 0;  ///< grants ended at their now (a changed acceptance filter)
+  /// Something reached a process before the time it had been granted to: a broken premise of
+  /// per-node lookahead (a node's timer that sent what it had not said). 0 unless a bug.
+  std::uint64_t causality_errors = 0;
   std::chrono::nanoseconds wall{0};       ///< real time spent running (not held, not idle)
   std::chrono::nanoseconds simulated{0};  ///< simulated time run meanwhile
 };
@@ -105,9 +137,21 @@ class TimeConductor {
   void Pending(GrantedSession& session);
   /// Frames the node sent, stamped with their times: put on the bus at those times.
   void Submit(GrantedSession& session, broker::PortId port, std::span<const wire::StampedFrame> frames);
-  /// TimeReached from the session's node. False on a protocol violation (not granted, another time).
-  bool Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline);
+  /// TimeReached from the session's node, with what its timers may send (nullptr: anything, from
+  /// its next deadline). False on a protocol violation (not granted; not the grant's end nor, for
+  /// a grant longer than kLookahead, a time within it: an early stop for a changed filter).
+  bool Reached(GrantedSession& session, TimePoint time, std::optional<TimePoint> next_deadline,
+               const SendOutlook* outlook = nullptr);
   bool Participates(const GrantedSession& session) const { return sessions_.contains(&session); }
+
+  // --- the broker's own ports that answer at once (the fleet's CANopen master) ---
+  /// A port of this process on `bus` that may send as soon as it hears something: the fleet's
+  /// CANopen master configures a node when it sees its boot-up, and its SDO client answers a
+  /// server while `busy()`. Per-node lookahead counts it as a process with no timers of its own
+  /// (its timers are the broker's): without it, a port that transmits and is no node process
+  /// keeps its bus from being calm. Returns the id for RemoveReactor.
+  std::uint64_t AddReactor(std::string bus, std::function<bool()> busy);
+  void RemoveReactor(std::uint64_t id);
 
   // --- outside inputs ---
   /// Runs `action` at the current time between rounds: now if no round is open, else when the
@@ -156,14 +200,19 @@ class TimeConductor {
   struct Participant {
     std::string clock_id;
     std::vector<GrantedSession*> sessions;
-    std::size_t ports = 1;          ///< how many the process attaches (Hello.clock_ports)
-    std::optional<TimePoint> next;  ///< its next deadline, as last reported
-    bool pending = false;           ///< something was sent to it at the current time
+    std::size_t ports = 1;                    ///< how many the process attaches (Hello.clock_ports)
+    std::optional<TimePoint> next;            ///< its next deadline, as last reported
+    bool pending = false;                     ///< something was sent to it at the current time
+    TimePoint reached{};                      ///< the time it has run to (at or after the bus's)
+    SendOutlook outlook;                      ///< what its timers may send, as last reported
+    bool has_outlook = false;                 ///< it said (else: anything from `next`)
+    std::vector<HorizonPort> ports_of_round;  ///< its sessions' buses and filters (reused)
   };
   struct SessionState {
     Participant* participant = nullptr;
     std::uint64_t attachment = 0;  ///< the process's number for the connection (Hello.clock_attachment)
     bool granted = false;          ///< granted in the open round and not answered yet
+    TimePoint now{}, until{};      ///< its grant in the open round
   };
   struct Submission {
     TimePoint time;
@@ -180,8 +229,26 @@ class TimeConductor {
   void StartRound();
   /// Opens a round to G; false when nothing is due (idle) or pacing delays it.
   bool OpenRound();
+  /// The same with per-node lookahead: each process to its own horizon.
+  bool OpenPerNodeRound(TimePoint now);
+  /// Grant each session marked granted (SessionState::now/until), in a stated order.
+  void SendGrants();
   void CloseRound();
   void AdvanceBroker(TimePoint until);
+  /// Per-node lookahead: runs the bus up to `until`, instant by instant, and stops after the first
+  /// instant at which something reached a process (or a hold began).
+  void AdvanceBrokerUntilInput(TimePoint until);
+  /// Fills nodes_/buses_ for the participants (order_) and computes their horizons.
+  void ComputeHorizons(TimePoint now, std::optional<TimePoint> cap);
+  bool PerNode() const {
+    return options_.lookahead == TimeConductorOptions::Lookahead::kPerNode && drives_ == 0 &&
+           options_.speed == 0;
+  }
+  /// The furthest time a process has run to (Now() when none is ahead).
+  TimePoint Frontier() const;
+  /// No process stands beyond the bus's time: outside inputs may be applied now.
+  bool CaughtUp() const { return Frontier() <= Now(); }
+  void MarkPending(Participant& p);
   void RunBoundaryActions();
   /// Forgets processes whose every session left (and the frames they still had to go).
   void Prune();
@@ -212,6 +279,33 @@ class TimeConductor {
   std::uint64_t next_sequence_ = 0;
   std::deque<std::function<void()>> boundary_;
   std::vector<std::uint64_t> attachments_;  ///< the grant being sent names these (reused)
+
+  struct Reactor {
+    std::uint64_t id = 0;
+    std::string bus;
+    std::function<bool()> busy;
+    std::vector<HorizonPort> ports;  ///< one (reused)
+  };
+  std::vector<Reactor> reactors_;
+  std::uint64_t next_reactor_ = 1;
+  /// What a reactor hears: boot-ups (700h + node-ID), and SDO answers (580h + node-ID) while busy.
+  Acceptance boot_ups_, boot_ups_and_answers_, answers_, nothing_;
+
+  // Per-node lookahead (reused between rounds).
+  std::vector<Participant*> order_;
+  std::vector<std::string> bus_names_;
+  std::vector<HorizonBus> buses_;
+  std::vector<std::size_t> bus_sessions_;  ///< per bus: sessions of participants on it
+  std::vector<HorizonNode> nodes_;
+  broker::BusOutlook bus_outlook_;
+  TimerOutlook broker_timers_;
+  GrantHorizons horizons_;
+  std::size_t pending_count_ = 0;  ///< participants with pending set
+  bool per_node_round_ = false;    ///< the open round grants per node
+  bool causality_logged_ = false;
+  /// The furthest a round may grant beyond the bus's time: a bound for a process that nothing can
+  /// reach (it has its deadlines; the outside inputs wait for the bus to catch up with it).
+  static constexpr Duration kMaxGrant = std::chrono::seconds(1);
 
   bool round_open_ = false;
   bool advancing_ = false;

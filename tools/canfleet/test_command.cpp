@@ -16,6 +16,7 @@ struct TestArgs {
   std::string junit;
   std::string time;  ///< "" = each topology's time.mode
   std::string speed;
+  std::string lookahead = "node";
   std::string capture;
   std::uint64_t seed = 0;
   std::string state_dir;
@@ -48,6 +49,13 @@ void AddTestCommand(CLI::App& app, Cli& cli) {
       ->check(CLI::IsMember({"real", "virtual"}));
   test->add_option("--speed", args->speed, "Virtual time: max, or simulated seconds per real second");
   test->add_option(
+          "--lookahead", args->lookahead,
+          "Virtual time at max speed: grant each node process as far as nothing it listens to can "
+          "reach it (node), or all to the lookahead of the earliest (global: as before issue 34, for "
+          "comparison); the captures are the same")
+      ->check(CLI::IsMember({"node", "global"}))
+      ->capture_default_str();
+  test->add_option(
       "--capture", args->capture,
       "Capture every bus to DIR/<file>-<bus>.log (candump log; in virtual time the timestamps are "
       "simulated seconds, the same on every run)");
@@ -74,6 +82,7 @@ void AddTestCommand(CLI::App& app, Cli& cli) {
         options.files.emplace_back(file);
       options.junit = args->junit;
       options.time.mode = args->time;
+      options.time.global_lookahead = args->lookahead == "global";
       if (!args->speed.empty()) {
         try {
           options.time.speed = fleet::ParseSpeed(args->speed);

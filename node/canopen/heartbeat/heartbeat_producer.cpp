@@ -18,6 +18,13 @@ HeartbeatProducer::HeartbeatProducer(ObjectDictionary& od, BusPort& port, Schedu
   }
 }
 
+void HeartbeatProducer::SetNodeId(std::uint8_t node_id) {
+  node_id_ = node_id;
+  // Its timer sends the heartbeat and nothing else: in virtual time, a node that does not listen
+  // to it is not held back by it (Timer::Confine).
+  timer_.Confine(IsValidNodeId(node_id_) ? kErrorControlCobId + node_id_ : Timer::kUnconfined);
+}
+
 Duration HeartbeatProducer::Period() const {
   return std::chrono::milliseconds(od_.GetUnsigned(kProducerHeartbeatTimeIndex, 0) & 0xFFFF);
 }

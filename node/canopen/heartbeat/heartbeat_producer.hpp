@@ -30,7 +30,7 @@ class HeartbeatProducer {
 
   /// The node-ID whose COB-ID (700h + id) the heartbeat uses. No heartbeat is sent while the
   /// node-ID is not 1..127 (the initial value is 0).
-  void SetNodeId(std::uint8_t node_id) { node_id_ = node_id; }
+  void SetNodeId(std::uint8_t node_id);
 
   /// Starts production (call after boot-up).
   void Start();

@@ -41,6 +41,13 @@ void Tpdo::SetOperational(bool operational) {
 void Tpdo::Restart() {
   event_timer_.Cancel();
   inhibit_timer_.Cancel();
+  // Both timers send this TPDO and nothing else: in virtual time, a node that does not listen to
+  // it is not held back by them (Timer::Confine). A 29-bit identifier is not confined: acceptance
+  // filters are for 11-bit identifiers only.
+  const auto& cob_id = config_.comm().cob_id;
+  const std::uint32_t key = cob_id.extended ? Timer::kUnconfined : cob_id.can_id;
+  event_timer_.Confine(key);
+  inhibit_timer_.Confine(key);
   event_pending_ = false;
   phase_ = SyncPhase::kFirst;
   countdown_ = 0;

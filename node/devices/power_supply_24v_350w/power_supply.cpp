@@ -141,8 +141,9 @@ void PowerSupply::Attach(DeviceContext& context) {
       store->Exclude(index);
   }
   // §1.2.2: "The controller will wake upon receiving a CAN frame, or when the Remote Enable
-  // signal changes state."
-  port_->ObserveFrames([this](const CanFrame&) { sleep_->Wake(); });
+  // signal changes state." Awake, it needs no frame its stack does not listen to: its acceptance
+  // filter lets every frame through only while it sleeps.
+  port_->ObserveFrames([this](const CanFrame&) { sleep_->Wake(); }, [this] { return sleep_->Asleep(); });
   io_subscription_ = io_.Subscribe([this](const IoSignal& signal) {
     if (&signal == signals_.enable) sleep_->Wake();
   });
@@ -199,6 +200,7 @@ void PowerSupply::OnResetApplication() {
 
 void PowerSupply::OnSleepChange(bool asleep) {
   io_.Publish(*signals_.asleep, asleep);
+  if (port_) port_->AcceptanceMayHaveChanged();  // asleep, any frame wakes it
   if (!asleep) RequestStep();
 }
 

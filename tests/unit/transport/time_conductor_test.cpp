@@ -1,7 +1,8 @@
 // The broker's side of lock-step virtual time (orchestrator/transport/time_conductor.hpp): rounds,
 // the lookahead bound, frames put on the bus at their stamped times, outside inputs between rounds,
-// and a node that stops answering. Fake node sessions on a real Broker; the event loop is polled,
-// never run against the clock (the grace test uses a grace of 0 ms).
+// and a node that stops answering; with one G for all (the Conductor tests, as driven and paced
+// time run) and with per-node lookahead (the PerNode tests, issue 34). Fake node sessions on a real Broker;
+// the event loop is polled, never run against the clock (the grace test uses a grace of 0 ms).
 #include "orchestrator/transport/time_conductor.hpp"
 
 #include <gtest/gtest.h>
@@ -53,6 +54,7 @@ class FakeNode final : public GrantedSession, public broker::PortSink {
   }
   const std::string& Label() const override { return name_; }
   const std::string& Bus() const override { return bus_; }
+  const Acceptance& Accepting() const override { return accepting; }
 
   // PortSink
   void Deliver(std::span<const broker::TimedFrame> frames) override {
@@ -62,12 +64,21 @@ class FakeNode final : public GrantedSession, public broker::PortSink {
   }
   void ControllerChanged(const ControllerEvent&) override { conductor_.Pending(*this); }
 
-  /// Answers the last grant as the node would: frames sent during it, then TimeReached.
-  bool Reach(std::optional<Duration> next, std::vector<wire::StampedFrame> frames = {}) {
+  /// Answers the last grant as the node would: frames sent during it, then TimeReached, with what
+  /// its timers may send when `outlook` says (else anything from `next`).
+  bool Reach(std::optional<Duration> next, std::vector<wire::StampedFrame> frames = {},
+             const SendOutlook* outlook = nullptr) {
     if (!frames.empty()) conductor_.Submit(*this, port, frames);
     const TimePoint until(Duration(grants.back().second));
-    return conductor_.Reached(*this, until, next ? std::optional(TimePoint(*next)) : std::nullopt);
+    return conductor_.Reached(*this, until, next ? std::optional(TimePoint(*next)) : std::nullopt, outlook);
   }
+  /// The same, its timers confined as `confined` says and any other from `any` on.
+  bool ReachConfined(std::optional<Duration> next, std::vector<ConfinedSend> confined, Duration any,
+                     std::vector<wire::StampedFrame> frames = {}) {
+    SendOutlook outlook{TimePoint(any), std::move(confined)};
+    return Reach(next, std::move(frames), &outlook);
+  }
+  void Listen(std::vector<std::uint32_t> ids) { accepting.Set(false, ids); }
   void Leave() {
     if (left_) return;
     left_ = true;
@@ -76,6 +87,7 @@ class FakeNode final : public GrantedSession, public broker::PortSink {
   }
 
   broker::PortId port = 0;
+  Acceptance accepting;
   std::vector<std::pair<std::int64_t, std::int64_t>> grants;  ///< (now, until) in ns
   std::vector<std::vector<std::uint64_t>> named;              ///< each grant's attachments
   std::vector<std::string> received;
@@ -106,7 +118,7 @@ class Conductor : public ::testing::Test {
   asio::io_context io;
   GrantedScheduler scheduler;
   broker::Broker broker{scheduler};
-  TimeConductor conductor{io, scheduler, broker};
+  TimeConductor conductor{io, scheduler, broker, {.lookahead = TimeConductorOptions::Lookahead::kGlobal}};
 };
 
 // A node that joins may act at once (boot-up): its first grant is to now + the lookahead; then it
@@ -371,6 +383,109 @@ TEST_F(Conductor, TimeWaitsForARestartedProcessToJoin) {
   conductor.StopWaitingFor("c#3");  // it ended before it joined
   Poll();
   EXPECT_EQ(a.grants.size(), 2u) << "a's deadline (500 ms) is next";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-node lookahead (issue 34, grant_horizon.hpp): each process to its own horizon.
+
+class PerNode : public Conductor {
+ protected:
+  PerNode() {
+    a.Listen({0x702});  // b's heartbeat
+    b.Listen({0x7FF});  // nothing anybody sends
+    Poll();
+    // Both booted at 0 (pending): each may answer the other at once.
+    EXPECT_EQ(a.grants.back(), std::make_pair(std::int64_t{0}, L));
+    EXPECT_EQ(b.grants.back(), std::make_pair(std::int64_t{0}, L));
+  }
+  /// a: TPDO 181h every 100 ms, heartbeat 701h at 500 ms; b: TPDO 182h from 50 ms, heartbeat 702h
+  /// at 500 ms; their other timers (a consumer's timeout) at 1500 ms.
+  void FirstAnswers() {
+    ASSERT_TRUE(a.ReachConfined(100ms, {{0x181, TimePoint(100ms)}, {0x701, TimePoint(500ms)}}, 1500ms));
+    ASSERT_TRUE(b.ReachConfined(50ms, {{0x182, TimePoint(50ms)}, {0x702, TimePoint(500ms)}}, 1500ms));
+    Poll();
+  }
+  TimeConductor conductor{io, scheduler, broker};
+  FakeNode a{"a", conductor, broker};
+  FakeNode b{"b", conductor, broker};
+};
+
+// a listens only to b's heartbeat: it runs its own TPDO timers up to b's heartbeat in one grant,
+// although b's TPDO comes first. b may hear anything a sends, so it is held to a's horizon.
+TEST_F(PerNode, ANodeIsGrantedPastTheDeadlineOfANodeItDoesNotListenTo) {
+  FirstAnswers();
+  EXPECT_EQ(Ns(conductor.Now().time_since_epoch()), Ns(50ms)) << "the bus runs to the earliest deadline";
+  EXPECT_EQ(a.grants.back(), std::make_pair(Ns(50ms), Ns(500ms) + L));
+  EXPECT_EQ(b.grants.back(), std::make_pair(Ns(50ms), Ns(500ms) + 2 * L));
+}
+
+TEST_F(PerNode, ANodeIsHeldBackByADeadlineOfANodeItListensTo) {
+  a.Listen({0x702, 0x182});
+  FirstAnswers();
+  EXPECT_EQ(a.grants.size(), 1u) << "its next deadline (100 ms) lies beyond b's TPDO (50 ms)";
+  EXPECT_EQ(b.grants.back(), std::make_pair(Ns(50ms), Ns(50ms) + 2 * L));
+}
+
+// What a applied at its grant's now widened its filter: it stops there (early), and its next grant
+// is held to what it now listens to.
+TEST_F(PerNode, AFilterChangeStopsTheGrantAtItsNowAndBindsTheNext) {
+  FirstAnswers();
+  a.Listen({0x702, 0x182});
+  SendOutlook outlook{TimePoint(1500ms), {{0x181, TimePoint(100ms)}, {0x701, TimePoint(500ms)}}};
+  ASSERT_TRUE(conductor.Reached(a, TimePoint(50ms), TimePoint(100ms), &outlook)) << "an early stop";
+  EXPECT_EQ(conductor.Stats().early_stops, 1u);
+  // b ran to its grant's end; its TPDOs at 50..450 ms nobody listened to then, its next at 550 ms.
+  ASSERT_TRUE(b.ReachConfined(550ms, {{0x182, TimePoint(550ms)}, {0x702, TimePoint(1000ms)}}, 1500ms));
+  Poll();
+  EXPECT_EQ(a.grants.back(), std::make_pair(Ns(100ms), Ns(550ms) + L)) << "b's next TPDO, which a now hears";
+}
+
+// A fault that may corrupt transfers starts at 200 ms (a scenario step: a broker timer, which may
+// reach anybody): no grant reaches past it, and from then on the bus is not calm, so each node is
+// held to the earliest deadline on it, as with one G for all.
+TEST_F(PerNode, AFaultThatStartsMidGrantIsNotGrantedPast) {
+  Timer fault(scheduler, [&] { broker.Faults("can0").Add({.action = broker::RuleAction::kCorrupt}); });
+  fault.StartAt(TimePoint(200ms));
+  FirstAnswers();
+  EXPECT_EQ(a.grants.back(), std::make_pair(Ns(50ms), Ns(200ms)));
+  EXPECT_EQ(b.grants.back(), std::make_pair(Ns(50ms), Ns(200ms)));
+  ASSERT_TRUE(a.ReachConfined(250ms, {{0x181, TimePoint(300ms)}, {0x701, TimePoint(500ms)}}, 1500ms));
+  ASSERT_TRUE(b.ReachConfined(300ms, {{0x182, TimePoint(300ms)}, {0x702, TimePoint(500ms)}}, 1500ms));
+  Poll();
+  EXPECT_EQ(a.grants.back(), std::make_pair(Ns(250ms), Ns(250ms) + L));
+  EXPECT_EQ(b.grants.size(), 2u) << "b's deadline (300 ms) lies beyond the lock-step round";
+}
+
+// A control request while the processes stand ahead of the bus: it is applied once the bus has
+// caught up with the furthest of them (the frontier), never behind one.
+TEST_F(PerNode, AnOutsideInputWaitsForTheBusToCatchUpWithTheProcesses) {
+  FirstAnswers();
+  ASSERT_TRUE(a.ReachConfined(600ms, {{0x181, TimePoint(600ms)}, {0x701, TimePoint(1000ms)}}, 1500ms));
+  std::optional<TimePoint> applied;
+  conductor.AtBoundary([&] { applied = conductor.Now(); });
+  EXPECT_FALSE(applied) << "b's grant is open";
+  ASSERT_TRUE(b.ReachConfined(550ms, {{0x182, TimePoint(550ms)}, {0x702, TimePoint(1000ms)}}, 1500ms));
+  Poll();
+  ASSERT_TRUE(applied);
+  EXPECT_EQ(Ns(applied->time_since_epoch()), Ns(500ms) + 2 * L) << "where b stood, the furthest";
+}
+
+// A frame goes on the bus at its stamp although its sender stands further; its listener is woken
+// at its end of frame, where the bus stops.
+TEST_F(PerNode, AFrameReachesItsListenerAtItsEndOfFrame) {
+  b.Listen({0x181});
+  a.Listen({0x7FF});
+  ASSERT_TRUE(a.ReachConfined(100ms, {{0x181, TimePoint(100ms)}}, 1500ms));
+  ASSERT_TRUE(b.ReachConfined(1000ms, {{0x702, TimePoint(1000ms)}}, 1500ms));
+  Poll();
+  EXPECT_EQ(a.grants.back(), std::make_pair(Ns(100ms), Ns(100ms) + 2 * L));
+  EXPECT_EQ(b.grants.size(), 1u);
+  ASSERT_TRUE(a.ReachConfined(200ms, {{0x181, TimePoint(200ms)}}, 1500ms, {{Frame("181#01"), 100ms}}));
+  Poll();
+  const std::int64_t end = Ns(100ms + BitTime(CountFrameBits(Frame("181#01")).total(), kBitrate));
+  EXPECT_EQ(b.received, (std::vector<std::string>{"181#01@" + std::to_string(end)}));
+  EXPECT_EQ(b.grants.back(), std::make_pair(end, end + 2 * L));
+  EXPECT_EQ(conductor.Stats().causality_errors, 0u);
 }
 
 }  // namespace

@@ -19,10 +19,14 @@ struct FakePort : GrantedPort {
   void ApplyHeld() override {
     log_.push_back(name_ + " apply at " + std::to_string(s_.Now().time_since_epoch().count()));
   }
-  void Reached(TimePoint time, std::optional<TimePoint> next) override {
+  bool AcceptanceChanged() override { return filter_changed; }
+  void Reached(TimePoint time, std::optional<TimePoint> next, const TimerOutlook& outlook) override {
     log_.push_back(name_ + " reached " + std::to_string(time.time_since_epoch().count()) +
                    (next ? " next " + std::to_string(next->time_since_epoch().count()) : " idle"));
+    last_outlook = outlook;
   }
+  bool filter_changed = false;
+  TimerOutlook last_outlook;
   std::string name_;
   std::vector<std::string>& log_;
   GrantedScheduler& s_;
@@ -161,6 +165,76 @@ TEST(VirtualTimeClient, ANodeJoiningARunningBusStartsAtItsTime) {
   FakePort a("a", log, s);
   client.Connected(0, a, TimePoint(3600s));
   EXPECT_EQ(s.Now(), TimePoint(3600s));
+}
+
+// Per-node lookahead (issue 34): TimeReached says what the timers may send; a confined timer only
+// its identifier.
+TEST(VirtualTimeClient, TimeReachedSaysWhatTheTimersMaySend) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  Timer heartbeat(s, [] {});
+  Timer tpdo(s, [] {});
+  Timer tick(s, [] {});
+  heartbeat.Confine(0x705);
+  tpdo.Confine(0x185);
+  VirtualTimeClient client(s, "quad-5#1", 1);
+  FakePort port("p1", log, s);
+  client.Connected(0, port, TimePoint(0ns));
+  heartbeat.StartAt(TimePoint(500ms));
+  tpdo.StartAt(TimePoint(100ms));
+  tick.StartAt(TimePoint(1500ms));
+  client.Granted(0, TimePoint(0ns), TimePoint(24us));
+  EXPECT_EQ(port.last_outlook.unconfined, TimePoint(1500ms));
+  EXPECT_EQ(port.last_outlook.confined, (std::vector<std::pair<std::uint32_t, TimePoint>>{
+                                            {0x185, TimePoint(100ms)}, {0x705, TimePoint(500ms)}}));
+}
+
+// What was applied at the grant's now changed the acceptance filter: the broker granted as far as
+// the old filter allowed, so the process stops at now and reports that.
+TEST(VirtualTimeClient, AChangedFilterEndsALongGrantAtItsNow) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  Timer tpdo(s, [&] { log.push_back("tpdo at " + std::to_string(s.Now().time_since_epoch().count())); });
+  VirtualTimeClient client(s, "quad-5#1", 1);
+  FakePort port("p1", log, s);
+  client.Connected(0, port, TimePoint(0ns));
+  tpdo.StartAt(TimePoint(100ms));
+  port.filter_changed = true;
+  client.Granted(0, TimePoint(10ms), TimePoint(300ms));
+  EXPECT_EQ(log, (std::vector<std::string>{"p1 apply at 10000000", "p1 reached 10000000 next 100000000"}));
+  EXPECT_EQ(client.EarlyStops(), 1u);
+  log.clear();
+  client.Granted(0, TimePoint(10ms), TimePoint(10ms + 24us));
+  EXPECT_EQ(log, (std::vector<std::string>{"p1 apply at 10000000", "p1 reached 10024000 next 100000000"}))
+      << "a grant no longer than a frame's travel runs to its end";
+}
+
+// A timer changes the filter (a power supply falls asleep and wakes on any frame): the grant ends
+// after that instant.
+TEST(VirtualTimeClient, AFilterChangedByATimerEndsALongGrantAfterItsInstant) {
+  GrantedScheduler s;
+  std::vector<std::string> log;
+  VirtualTimeClient client(s, "ps-9#1", 1);
+  FakePort port("p1", log, s);
+  Timer sleep(s, [&] { port.filter_changed = true; });
+  Timer later(s, [&] { log.push_back("later"); });
+  client.Connected(0, port, TimePoint(0ns));
+  sleep.StartAt(TimePoint(40ms));
+  later.StartAt(TimePoint(60ms));
+  client.Granted(0, TimePoint(10ms), TimePoint(300ms));
+  EXPECT_EQ(log, (std::vector<std::string>{"p1 apply at 10000000", "p1 reached 40000000 next 60000000"}));
+}
+
+// A timer confined to one identifier that arms one confined otherwise breaks its promise: counted.
+TEST(VirtualTimeClient, AConfinedTimerThatArmsAnotherIsCounted) {
+  GrantedScheduler s;
+  Timer other(s, [] {});
+  Timer tpdo(s, [&] { other.StartAfter(1ms); });
+  tpdo.Confine(0x185);
+  tpdo.StartAt(TimePoint(1ms));
+  s.AdvanceTo(TimePoint(2ms));
+  EXPECT_EQ(s.ConfinementBreaches(), 1u);
+  EXPECT_EQ(s.RunningConfinement(), Timer::kUnconfined);
 }
 
 }  // namespace

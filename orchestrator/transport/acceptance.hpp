@@ -1,0 +1,53 @@
+#pragma once
+/// @file The identifiers a node's port listens to (wire::Acceptance: its acceptance filter, as a CAN
+/// controller's hardware filter). The session delivers only those frames, and the time conductor
+/// grants a node process no further than a frame it listens to could reach it (grant_horizon.hpp).
+
+#include <algorithm>
+#include <bitset>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "bus/can_frame.hpp"
+
+namespace canfleet::transport {
+
+class Acceptance {
+ public:
+  /// Every frame (`all`), or the 11-bit identifiers `ids` (others above 0x7FF are ignored).
+  void Set(bool all, std::span<const std::uint32_t> ids) {
+    all_ = all;
+    bits_.reset();
+    ids_.clear();
+    for (const std::uint32_t id : ids)
+      if (id <= 0x7FF) bits_.set(id);
+    for (std::uint32_t id = 0; id <= 0x7FF; ++id)
+      if (bits_.test(id)) ids_.push_back(id);
+  }
+
+  bool All() const { return all_; }
+  /// Listens to nothing: no frame can wake it.
+  bool Empty() const { return !all_ && ids_.empty(); }
+  /// The 11-bit identifiers listened to, ascending (without All()).
+  std::span<const std::uint32_t> Ids() const { return ids_; }
+  /// Extended and error frames always pass (the filter is for 11-bit identifiers).
+  bool Accepts(const CanFrame& frame) const {
+    return all_ || frame.extended() || frame.error() || bits_.test(frame.id & 0x7FF);
+  }
+  /// `key`: an 11-bit identifier, or kExtendedKey for any 29-bit frame.
+  bool AcceptsKey(std::uint32_t key) const { return all_ || key > 0x7FF || bits_.test(key); }
+
+  /// Stands for every 29-bit identifier in the keys of grant_horizon.hpp.
+  static constexpr std::uint32_t kExtendedKey = 0x800;
+  static std::uint32_t KeyOf(const CanFrame& frame) {
+    return frame.extended() || frame.error() ? kExtendedKey : frame.id & 0x7FF;
+  }
+
+ private:
+  bool all_ = true;  // until the node sends its filter: every frame
+  std::bitset<2048> bits_;
+  std::vector<std::uint32_t> ids_;
+};
+
+}  // namespace canfleet::transport
