@@ -144,6 +144,9 @@ class Timer {
 
   /// Anything: the default.
   static constexpr std::uint32_t kUnconfined = 0xFFFF'FFFF;
+  /// With a node's 11-bit key: the frames are heartbeats (one state byte, never a boot-up), which
+  /// a heartbeat consumer answers with nothing at once (wire::Acceptance.passive).
+  static constexpr std::uint32_t kHeartbeat = 0x1000;
   /// States that the callback's only effect others may notice is the one `key` names, and that it
   /// arms no timer confined otherwise (TimerOutlook). On a node, `key` is the 11-bit identifier of
   /// the one frame it may send; a broker's bus confines its timer to the bus's own events.

@@ -94,7 +94,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   /// from it breaks what per-node lookahead grants others on (issue 34). Counted, and said once.
   void CheckConfinement(const CanFrame& frame) {
     const std::uint32_t key = options_.virtual_time->scheduler().RunningConfinement();
-    if (key == Timer::kUnconfined || (!frame.extended() && frame.id == key)) return;
+    if (key == Timer::kUnconfined || (!frame.extended() && frame.id == (key & ~Timer::kHeartbeat))) return;
     ++stats_.confinement_breaches;
     if (breach_logged_) return;
     breach_logged_ = true;
@@ -132,6 +132,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   TxConfirmHandler on_tx_confirmed;
   NodeRequestHandler on_node_request;
   AcceptanceProvider acceptance;
+  PassiveProvider passive;
 
  private:
   enum class Phase : std::uint8_t { kIdle, kConnecting, kHandshake, kConnected, kWaiting, kStopped };
@@ -384,18 +385,34 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
     if (held_requests_.empty()) held_requests_.swap(requests);
   }
 
+  /// The filter as the node's configuration makes it now, with its passive heartbeats (virtual
+  /// time only: per-node lookahead is all they serve).
+  struct Filter {
+    std::optional<std::vector<std::uint32_t>> ids;
+    std::vector<std::pair<std::uint32_t, std::int64_t>> passive;
+    bool operator==(const Filter&) const = default;
+  };
+  Filter CurrentFilter() const {
+    Filter f{acceptance(), {}};
+    if (passive && options_.virtual_time && f.ids)
+      for (const auto& [id, delay] : passive())
+        f.passive.emplace_back(id, delay.count());
+    return f;
+  }
+  void AddFilter(wire::MessageWriter& out, const Filter& f) { out.AddAcceptance(f.ids, f.passive); }
+
   bool AcceptanceChanged() override {
     if (!acceptance || phase_ != Phase::kConnected) return false;
-    return acceptance_sent_ && acceptance() != last_acceptance_;
+    return acceptance_sent_ && CurrentFilter() != last_acceptance_;
   }
 
   void Reached(TimePoint time, std::optional<TimePoint> next_deadline, const TimerOutlook& outlook) override {
     if (phase_ != Phase::kConnected) return;
     if (acceptance) {
-      auto ids = acceptance();
-      if (!acceptance_sent_ || ids != last_acceptance_) {
-        filling_.AddAcceptance(ids);
-        last_acceptance_ = std::move(ids);
+      Filter filter = CurrentFilter();
+      if (!acceptance_sent_ || filter != last_acceptance_) {
+        AddFilter(filling_, filter);
+        last_acceptance_ = std::move(filter);
         acceptance_sent_ = true;
       }
     }
@@ -406,8 +423,9 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
     if (outlook.unconfined) reached_outlook_.any_ns = outlook.unconfined->time_since_epoch().count();
     for (const auto& [key, deadline] : outlook.confined) {
       const std::int64_t ns = deadline.time_since_epoch().count();
-      if (key <= 0x7FF)
-        reached_outlook_.confined.emplace_back(key, ns);
+      const std::uint32_t id = key & ~Timer::kHeartbeat;
+      if (id <= 0x7FF)
+        reached_outlook_.confined.push_back({id, ns, (key & Timer::kHeartbeat) != 0});
       else
         reached_outlook_.any_ns = std::min(reached_outlook_.any_ns.value_or(ns), ns);
     }
@@ -426,13 +444,13 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   /// controller whose filter is being rewritten.
   void RefreshAcceptance() {
     if (!acceptance) return;
-    auto ids = acceptance();
+    Filter ids = CurrentFilter();
     if (acceptance_sent_ && ids == last_acceptance_) return;
     if (filling_.empty()) {
-      filling_.AddAcceptance(ids);
+      AddFilter(filling_, ids);
     } else {
       acceptance_first_.Clear();
-      acceptance_first_.AddAcceptance(ids);
+      AddFilter(acceptance_first_, ids);
       const std::span<const std::uint8_t> rest = filling_.Bytes();
       acceptance_first_.AddEncoded(rest.data(), rest.size());
       filling_.Swap(acceptance_first_);
@@ -668,7 +686,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
   std::vector<Held> held_;
   std::vector<wire::NodeRequest> held_requests_;
   /// The acceptance filter last sent on this connection.
-  std::optional<std::vector<std::uint32_t>> last_acceptance_;
+  Filter last_acceptance_;
   bool acceptance_sent_ = false;
   bool breach_logged_ = false;
   wire::MessageWriter::ReachedOutlook reached_outlook_;  ///< reused
@@ -697,6 +715,10 @@ bool BrokerClientPort::SetBitRate(std::uint32_t bit_per_s) {
   if (bit_per_s != 0 && (bit_per_s < kMinBitrate || bit_per_s > kMaxBitrate)) return false;
   link_->SetBitRate(bit_per_s);
   return true;
+}
+
+void BrokerClientPort::OnPassive(PassiveProvider provider) {
+  link_->passive = std::move(provider);
 }
 
 void BrokerClientPort::AcceptanceMayHaveChanged() {

@@ -108,6 +108,9 @@ class BrokerClientPort final : public BusPort {
   /// change sent before TimeReached. Real time: asked before each write, a change sent first in
   /// that write. Until the first Acceptance of a connection the broker delivers every frame.
   using AcceptanceProvider = std::function<std::optional<std::vector<std::uint32_t>>()>;
+  /// Of the identifiers the filter lets through, the heartbeats the node answers with nothing
+  /// before a delay (wire::Acceptance.passive), sent with the filter; asked with it.
+  using PassiveProvider = std::function<std::vector<std::pair<std::uint32_t, Duration>>()>;
 
   /// Throws std::invalid_argument on a malformed endpoint.
   BrokerClientPort(asio::io_context& io, BrokerClientOptions options);
@@ -139,6 +142,7 @@ class BrokerClientPort final : public BusPort {
   /// "<node name> serves no node requests", so the broker is not left waiting.
   void OnNodeRequest(NodeRequestHandler handler);
   void OnAcceptance(AcceptanceProvider provider);
+  void OnPassive(PassiveProvider provider);
 
   const BrokerClientStats& Stats() const;
 

@@ -154,19 +154,26 @@ void MessageWriter::AddTimeReached(std::int64_t time_ns, std::optional<std::int6
     reached->set_has_outlook(true);
     reached->set_has_any(outlook->any_ns.has_value());
     reached->set_any_ns(outlook->any_ns.value_or(0));
-    for (const auto& [id, deadline] : outlook->confined) {
+    for (const auto& confined : outlook->confined) {
       auto* c = reached->add_confined();
-      c->set_id(id);
-      c->set_deadline_ns(deadline);
+      c->set_id(confined.id);
+      c->set_deadline_ns(confined.deadline_ns);
+      c->set_heartbeat(confined.heartbeat);
     }
   });
 }
 
-void MessageWriter::AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids) {
+void MessageWriter::AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids,
+                                  std::span<const std::pair<std::uint32_t, std::int64_t>> passive) {
   AppendProto([&](Envelope& e) {
     auto* acceptance = e.mutable_acceptance();
     acceptance->set_all(!ids.has_value());
     if (ids) acceptance->mutable_ids()->Add(ids->begin(), ids->end());
+    for (const auto& [id, delay] : passive) {
+      auto* p = acceptance->add_passive();
+      p->set_id(id);
+      p->set_delay_ns(delay);
+    }
   });
 }
 

@@ -99,15 +99,22 @@ class MessageWriter {
                     std::span<const std::uint64_t> attachments = {});
   /// What a node's timers may send (TimeReached's outlook, per-node lookahead), in nanoseconds.
   struct ReachedOutlook {
-    std::optional<std::int64_t> any_ns;                            ///< any identifier from then on
-    std::vector<std::pair<std::uint32_t, std::int64_t>> confined;  ///< (11-bit identifier, deadline)
+    struct Confined {
+      std::uint32_t id;  ///< 11-bit
+      std::int64_t deadline_ns;
+      bool heartbeat;
+    };
+    std::optional<std::int64_t> any_ns;  ///< any identifier from then on
+    std::vector<Confined> confined;
   };
   /// TimeReached{time_ns, next deadline, outlook} (virtual time, node -> broker); no deadline:
   /// nullopt; no outlook: nullptr (the broker takes every timer to send anything).
   void AddTimeReached(std::int64_t time_ns, std::optional<std::int64_t> next_deadline_ns,
                       const ReachedOutlook* outlook = nullptr);
-  /// Acceptance{ids} (virtual time, node -> broker); nullopt: every frame.
-  void AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids);
+  /// Acceptance{ids, passive} (node -> broker); nullopt: every frame. `passive`: (identifier,
+  /// delay in ns) of heartbeats answered with nothing before that delay.
+  void AddAcceptance(const std::optional<std::vector<std::uint32_t>>& ids,
+                     std::span<const std::pair<std::uint32_t, std::int64_t>> passive = {});
   /// Appends bytes that are already wire encoding (messages, or the unwritten tail of a write
   /// that went to the socket only in part), after closing the open batch.
   void AddEncoded(const std::uint8_t* bytes, std::size_t size);

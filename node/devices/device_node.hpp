@@ -76,6 +76,11 @@ class DeviceNode {
     if (device_ports_.at(port)->Observed()) return std::nullopt;
     return stacks_.at(port)->ListenedIds();
   }
+  /// Of those, the heartbeats answered with nothing at once (canopen::CanopenStack::PassiveIds).
+  std::vector<std::pair<std::uint32_t, Duration>> PassiveIds(std::size_t port) const {
+    if (device_ports_.at(port)->Observed()) return {};
+    return stacks_.at(port)->PassiveIds();
+  }
 
  private:
   void ShareObjects();

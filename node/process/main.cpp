@@ -187,6 +187,7 @@ int Run(const node::NodeOptions& options, const node::TelemetrySettings& telemet
     });
     // The broker wakes the node only for frames its stack listens to (an acceptance filter).
     client->OnAcceptance([&node, p] { return node->ListenedIds(p); });
+    client->OnPassive([&node, p] { return node->PassiveIds(p); });
   }
   for (const auto& assignment : options.io) {
     auto eq = assignment.find('=');

@@ -115,8 +115,11 @@ Fleet::Fleet(asio::io_context& io, Scheduler& scheduler, broker::Broker& broker,
     // Virtual time: the master answers at once what it hears (a boot-up, an SDO answer); per-node
     // lookahead must know (TimeConductor::AddReactor).
     if (options_.conductor != nullptr)
-      reactors_.push_back(
-          options_.conductor->AddReactor(bus, [this, bus] { return sdo_.at(bus)->Pending() > 0; }));
+      reactors_.push_back(options_.conductor->AddReactor(bus, [this, bus] {
+        using Reaction = transport::TimeConductor::Reaction;
+        if (runner_ && runner_->MayReadOnFrames()) return Reaction::kAnything;
+        return sdo_.at(bus)->Pending() > 0 ? Reaction::kBootUpsAndAnswers : Reaction::kBootUps;
+      }));
   }
   tracker_.OnBootUp([this](const std::string& bus, std::uint8_t id) { OnBootUp(bus, id); });
   tracker_.OnEmcy([this](const std::string& bus, std::uint8_t id, const SeenEmcy& emcy) {

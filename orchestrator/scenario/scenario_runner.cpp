@@ -30,6 +30,15 @@ struct ScenarioRunner::Expectation {
   bool decided() const { return verdict().outcome != Outcome::kPending; }
 };
 
+bool ScenarioRunner::MayReadOnFrames() const {
+  for (const auto& e : expects_) {
+    if (e->decided()) continue;
+    const auto kind = e->spec->expect().what_case();
+    if (kind == topology::Expect::kSdo || kind == topology::Expect::kIo) return true;
+  }
+  return false;
+}
+
 struct ScenarioRunner::Action {
   int step = 0;
   std::unique_ptr<Timer> timer;

@@ -110,6 +110,10 @@ class ScenarioRunner {
   Progress GetProgress() const;
   std::size_t Expectations() const { return expects_.size(); }
   bool Done() const;
+  /// Some undecided expectation reads the nodes (by SDO or their simulated I/O): a frame that
+  /// opens its window may start a read at once (per-node lookahead then cannot let the nodes run
+  /// ahead of the bus, TimeConductor::AddReactor).
+  bool MayReadOnFrames() const;
   /// When the scenario started (unset before Start).
   std::optional<TimePoint> origin() const {
     return started_ ? std::optional<TimePoint>(origin_) : std::nullopt;

@@ -4,8 +4,8 @@
 /// reach it. Pure computation: TimeConductor gathers what it knows and grants from the result.
 ///
 /// What reaches a node process on a port:
-/// - frames already on the bus (in flight, queued, delayed by a fault) that it listens to: from the
-///   bus's next event on;
+/// - frames already on the bus (in flight, queued, delayed by a fault), or sent ahead of it, that it
+///   listens to: from the bus's next event on, or from their stamps plus the lookahead;
 /// - frames the other processes will send that it listens to: from the earliest time the sender
 ///   may send that identifier, plus the lookahead (no frame ends sooner after its submission).
 ///   A sender may send an identifier from its earliest timer that is not confined to other
@@ -18,7 +18,10 @@
 ///   `cap`, the same for every process.
 /// The earliest time a process may send anything depends on the earliest time something reaches
 /// it, so the two are computed together, to a fixed point (Chandy-Misra-Bryant's lower bounds on
-/// the time stamps of a process's messages, with the acceptance filters as its links).
+/// the time stamps of a process's messages, with the acceptance filters as its links). A heartbeat
+/// on a passive identifier (a consumer that only re-arms its timeout) makes it send nothing before
+/// the identifier's delay: a ring of heartbeat consumers does not hold every node to the ring's
+/// earliest heartbeat.
 
 #include <cstddef>
 #include <cstdint>
@@ -35,32 +38,49 @@ namespace canfleet::transport {
 struct ConfinedSend {
   std::uint32_t id = 0;
   TimePoint time{};
+  /// A heartbeat producer's: one state byte, never a boot-up (Acceptance::Passive applies).
+  bool heartbeat = false;
   bool operator==(const ConfinedSend&) const = default;
 };
 
+/// A frame a process sent, stamped `time`, that is not on the bus yet (the process ran ahead).
+struct KnownFrame {
+  std::size_t bus = 0;
+  std::size_t owner = 0;  ///< index of the node that sent it
+  std::uint32_t key = 0;  ///< Acceptance::KeyOf
+  TimePoint time{};
+  bool heartbeat = false;  ///< IsHeartbeat
+};
+
+/// A heartbeat (CiA 301 §7.2.8.3.2.2: 701h..77Fh, one state byte), not a boot-up (state 00h): what
+/// a passive identifier (Acceptance::Passive) answers only after its delay.
+inline bool IsHeartbeat(const CanFrame& f) {
+  return !f.extended() && !f.remote() && !f.error() && f.id > 0x700 && f.id <= 0x77F && f.dlc == 1 &&
+         (f.data[0] & 0x7F) != 0;
+}
+
+/// A frame on a bus (in flight, queued, delayed by a fault).
+struct PendingFrame {
+  std::uint32_t key = 0;  ///< Acceptance::KeyOf
+  bool heartbeat = false;
+};
+
 struct HorizonBus {
-  /// No transfer can fail and no controller change state by itself; only node processes transmit.
+  /// No transfer can fail and no controller change state by itself; only node processes (and
+  /// reactors, which count as such) transmit.
   bool calm = false;
   std::optional<TimePoint> next_event;
-  /// Acceptance keys of the frames on the bus (Acceptance::KeyOf), in any order.
-  std::vector<std::uint32_t> pending_keys;
-  bool boot_up = false;  ///< one of them is a boot-up (CiA 301: 700h + node-ID, one byte 00h)
+  std::vector<PendingFrame> pending;  ///< each reaches its listeners at next_event or later
 };
 
 struct HorizonPort {
   std::size_t bus = 0;  ///< index into the buses
-  /// What it hears of what the others send from unconfined timers or on input.
   const Acceptance* acceptance = nullptr;
-  /// What it hears of what their confined timers send, and of the frames on the bus; nullptr: as
-  /// `acceptance`. A master that configures a node when it boots up hears boot-ups, which a
-  /// heartbeat producer's timer never sends.
-  const Acceptance* confined = nullptr;
-  bool boot_ups = false;  ///< frames on the bus reach it when one is a boot-up
-  const Acceptance& Confined() const { return confined != nullptr ? *confined : *acceptance; }
 };
 
 struct HorizonNode {
   bool pending = false;           ///< something reached it at `now`
+  Duration reacts_after{};        ///< pending: it sends nothing on what reached it before now + this
   std::optional<TimePoint> next;  ///< its earliest timer
   /// Its earliest timer that may send any identifier (not confined); as `next` when it said nothing.
   std::optional<TimePoint> any;
@@ -73,8 +93,10 @@ class GrantHorizons {
   /// Computes, for each node, the earliest time anything can reach it after `now` (nullopt:
   /// nothing can), at most `cap`. `lookahead`: the shortest time from a frame's submission to
   /// anything a receiver sees of it.
+  /// `known`: frames sent ahead of the bus.
   void Compute(TimePoint now, Duration lookahead, std::optional<TimePoint> cap,
-               std::span<const HorizonBus> buses, std::span<const HorizonNode> nodes);
+               std::span<const HorizonBus> buses, std::span<const HorizonNode> nodes,
+               std::span<const KnownFrame> known = {});
   std::optional<TimePoint> Of(std::size_t node) const {
     return horizon_[node] == kNever ? std::nullopt : std::optional(horizon_[node]);
   }
@@ -91,24 +113,27 @@ class GrantHorizons {
     void Add(TimePoint t, std::size_t who);
     TimePoint Except(std::size_t who) const { return who == owner ? second : first; }
   };
-  struct Confined {
-    std::size_t bus;
-    std::uint32_t id;
-    TimePoint time;
-    std::size_t owner;
-  };
-  /// The earliest time `node` hears a confined identifier from another process on `bus`
-  /// (`acceptance`: HorizonPort::Confined).
-  TimePoint ConfinedBound(std::size_t node, std::size_t bus, const Acceptance& acceptance) const;
+  /// The earliest time `node` hears a confined identifier (or a known frame) from another process
+  /// on `bus`, and the earliest time that may make it send.
+  std::pair<TimePoint, TimePoint> ConfinedBound(std::size_t node, std::size_t bus,
+                                                const Acceptance& acceptance) const;
 
   std::vector<TimePoint> own_;     ///< earliest time each may send anything by itself
   std::vector<TimePoint> active_;  ///< its earliest timer at all
   std::vector<TimePoint> sends_;   ///< earliest time it may send anything (own_ or on input)
   std::vector<TimePoint> fixed_;  ///< per node: the part of its horizon that does not move in the fixed point
+  std::vector<TimePoint> fixed_react_;  ///< the same for what may make it send (passive frames later)
   std::vector<TimePoint> horizon_;
-  std::vector<Best2> any_;          ///< per bus: over its nodes, sends_
-  std::vector<Best2> all_;          ///< per bus: over its nodes, min(active_, sends_)
-  std::vector<Confined> confined_;  ///< sorted by (bus, id, time)
+  std::vector<Best2> any_;                   ///< per bus: over its nodes, sends_
+  std::vector<Best2> all_;                   ///< per bus: over its nodes, min(active_, sends_)
+  static constexpr std::size_t kIds = 2048;  ///< 11-bit identifiers
+  /// Per bus and identifier, the two earliest confined times and the owner of the earliest: of
+  /// heartbeats (beats_, which a passive identifier answers only after its delay), of the rest.
+  std::vector<Best2> table_, beats_;
+  std::vector<std::size_t> touched_;  ///< entries of table_ and beats_ set in this Compute
+  std::vector<TimePoint> anybody_;    ///< per bus: the earliest known frame that may reach anybody
+  std::vector<Best2> noted_;          ///< per bus: over every Note (what an accept-all port hears)
+  void Note(std::size_t bus, std::uint32_t id, TimePoint time, std::size_t owner, bool heartbeat);
   std::size_t passes_ = 0;
 };
 

@@ -186,7 +186,7 @@ void NodeSession::Handle(const wire::Message& m) {
         for (const auto& c : reached.confined()) {
           const TimePoint deadline(Duration(c.deadline_ns()));
           if (c.id() <= 0x7FF)
-            outlook_.confined.push_back({c.id(), deadline});
+            outlook_.confined.push_back({c.id(), deadline, c.heartbeat()});
           else  // not an 11-bit identifier: taken as anything
             outlook_.any = std::min(outlook_.any.value_or(deadline), deadline);
         }
@@ -200,8 +200,11 @@ void NodeSession::Handle(const wire::Message& m) {
     }
     case MessageType::kAcceptance: {
       const auto& acceptance = m.envelope.acceptance();
+      passive_.clear();
+      for (const auto& p : acceptance.passive())
+        if (p.delay_ns() > 0) passive_.push_back({p.id(), Duration(p.delay_ns())});
       acceptance_.Set(acceptance.all(),
-                      {acceptance.ids().data(), static_cast<std::size_t>(acceptance.ids().size())});
+                      {acceptance.ids().data(), static_cast<std::size_t>(acceptance.ids().size())}, passive_);
       return;
     }
     case MessageType::kTimeGrant:
@@ -470,13 +473,15 @@ void NodeSession::Deliver(std::span<const broker::TimedFrame> frames) {
   if (!acceptance_.All()) {
     // What the node does not listen to does not wake it (its acceptance filter).
     std::size_t accepted = 0;
+    Duration reacts_after = Duration::max();
     for (const broker::TimedFrame& f : frames) {
       if (!Accepts(f.frame)) continue;
       filling_.AddFrame(f.frame, f.time);
+      reacts_after = std::min(reacts_after, ReactsAfter(f.frame));
       ++accepted;
     }
     stats_->filtered_frames += frames.size() - accepted;
-    if (accepted > 0) Queued();
+    if (accepted > 0) Queued(reacts_after);
     return;
   }
   filling_.AddFrames(wire::MessageType::kFrames, frames, Stamped);
@@ -497,9 +502,14 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     // every frame of the round, they go out as without a filter (gathered, below).
     const std::span<const broker::TimedFrame> all = round.Frames();
     std::size_t accepted = 0;
-    for (const broker::FrameRun& run : runs)
-      for (std::uint32_t i = run.begin; i < run.end; ++i)
-        accepted += Accepts(all[i].frame) ? 1 : 0;
+    Duration reacts_after = Duration::max();
+    for (const broker::FrameRun& run : runs) {
+      for (std::uint32_t i = run.begin; i < run.end; ++i) {
+        if (!Accepts(all[i].frame)) continue;
+        ++accepted;
+        reacts_after = std::min(reacts_after, ReactsAfter(all[i].frame));
+      }
+    }
     stats_->filtered_frames += frames - accepted;
     if (accepted == 0) return;
     if (accepted < frames) {
@@ -508,7 +518,16 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
           if (Accepts(all[i].frame))
             filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{i} * wire::kFrameRecordSize,
                                 1);
-      Queued();
+      Queued(reacts_after);
+      return;
+    }
+    if (granted_) {
+      // Every frame of the round passes the filter: gathered below, and as passive as they are.
+      filling_.ExpectFrames(wire::MessageType::kFrames, frames);
+      for (const broker::FrameRun& run : runs)
+        filling_.AddRecords(wire::MessageType::kFrames,
+                            records + std::size_t{run.begin} * wire::kFrameRecordSize, run.size());
+      Queued(reacts_after);
       return;
     }
   }

@@ -91,9 +91,11 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   void Accept(const wire::Hello& hello);
   /// Something was queued for the node: in real time it leaves at the end of this turn; in
   /// virtual time it happened now, and leaves with the grant of the next round.
-  void Queued() {
+  /// `reacts_after`: what was queued makes the node send nothing before this (heartbeats it only
+  /// watches, Acceptance::Passive); 0: it may answer at once.
+  void Queued(Duration reacts_after = Duration::zero()) {
     if (granted_) {
-      options_.time_conductor->Pending(*this);
+      options_.time_conductor->Pending(*this, reacts_after);
       return;
     }
     if (driven_) options_.time_conductor->Wake();  // the driver's step ends where this happened
@@ -148,7 +150,13 @@ class NodeSession final : public std::enable_shared_from_this<NodeSession>,
   Acceptance acceptance_;
   /// Whether `frame` passes the filter (extended and error frames always do).
   bool Accepts(const CanFrame& frame) const { return acceptance_.Accepts(frame); }
-  SendOutlook outlook_;  ///< of the last TimeReached (reused)
+  /// How long after `frame` arrives the node may answer it at the earliest (a heartbeat it only
+  /// watches: its delay; anything else: 0).
+  Duration ReactsAfter(const CanFrame& frame) const {
+    return IsHeartbeat(frame) ? acceptance_.DelayOf(frame.id) : Duration::zero();
+  }
+  SendOutlook outlook_;                       ///< of the last TimeReached (reused)
+  std::vector<Acceptance::Passive> passive_;  ///< of the last Acceptance (reused)
 
   wire::StreamDecoder decoder_;
   wire::Message message_;

@@ -29,21 +29,24 @@ TimeConductor::TimeConductor(asio::io_context& io, GrantedScheduler& scheduler, 
       grace_timer_(io),
       pace_timer_(io),
       join_timer_(io) {
-  std::vector<std::uint32_t> boot_ups, answers, both;
+  // A reactor answers a boot-up at once, a heartbeat never (it only watches it): heartbeats on
+  // those identifiers are passive for as long as a simulation runs.
+  constexpr Duration kNever = std::chrono::hours(24 * 365);
+  std::vector<std::uint32_t> boot_ups, both;
+  std::vector<Acceptance::Passive> heartbeats;
   for (std::uint32_t id = 1; id <= 0x7F; ++id) {
     boot_ups.push_back(0x700 + id);
-    answers.push_back(0x580 + id);
+    heartbeats.push_back({0x700 + id, kNever});
   }
   both = boot_ups;
-  both.insert(both.end(), answers.begin(), answers.end());
-  boot_ups_.Set(false, boot_ups);
-  answers_.Set(false, answers);
-  boot_ups_and_answers_.Set(false, both);
-  nothing_.Set(false, {});
+  for (std::uint32_t id = 1; id <= 0x7F; ++id)
+    both.push_back(0x580 + id);
+  boot_ups_.Set(false, boot_ups, heartbeats);
+  boot_ups_and_answers_.Set(false, both, heartbeats);
 }
 
-std::uint64_t TimeConductor::AddReactor(std::string bus, std::function<bool()> busy) {
-  reactors_.push_back({next_reactor_, std::move(bus), std::move(busy), {}});
+std::uint64_t TimeConductor::AddReactor(std::string bus, std::function<Reaction()> reaction) {
+  reactors_.push_back({next_reactor_, std::move(bus), std::move(reaction), {}});
   return next_reactor_++;
 }
 
@@ -114,14 +117,14 @@ void TimeConductor::Prune() {
   }
 }
 
-void TimeConductor::Pending(GrantedSession& session) {
+void TimeConductor::Pending(GrantedSession& session, Duration reacts_after) {
   auto it = sessions_.find(&session);
   if (it == sessions_.end()) return;
-  MarkPending(*it->second.participant);
+  MarkPending(*it->second.participant, reacts_after);
   Kick();
 }
 
-void TimeConductor::MarkPending(Participant& p) {
+void TimeConductor::MarkPending(Participant& p, Duration reacts_after) {
   if (Now() < p.reached) {
     // Per-node lookahead granted it past this: the premise of its horizon did not hold (a node's
     // timer sent what it had not said). It gets it at its own time, later than on the bus.
@@ -134,8 +137,12 @@ void TimeConductor::MarkPending(Participant& p) {
           p.clock_id, TimeText(Now()), TimeText(p.reached));
     }
   }
-  if (p.pending) return;
+  if (p.pending) {
+    p.reacts_after = std::min(p.reacts_after, reacts_after);
+    return;
+  }
   p.pending = true;
+  p.reacts_after = reacts_after;
   ++pending_count_;
 }
 
@@ -397,11 +404,13 @@ void TimeConductor::ComputeHorizons(TimePoint now, std::optional<TimePoint> cap)
   order_.clear();
   nodes_.clear();
   std::fill(bus_sessions_.begin(), bus_sessions_.end(), 0);
+  std::fill(anything_.begin(), anything_.end(), false);
   const auto bus_index = [this](const std::string& name) {
     auto it = std::ranges::find(bus_names_, name);
     if (it == bus_names_.end()) {
       bus_names_ = broker_.Buses();  // a bus added since
       bus_sessions_.resize(bus_names_.size(), 0);
+      anything_.resize(bus_names_.size(), false);
       it = std::ranges::find(bus_names_, name);
     }
     return static_cast<std::size_t>(it - bus_names_.begin());
@@ -414,14 +423,16 @@ void TimeConductor::ComputeHorizons(TimePoint now, std::optional<TimePoint> cap)
       p.ports_of_round.push_back({b, &session->Accepting()});
       ++bus_sessions_[b];
     }
+    p.round_index = order_.size();
     order_.push_back(&p);
   }
   for (Reactor& r : reactors_) {
     r.ports.clear();
     const std::size_t b = bus_index(r.bus);
     if (b >= bus_names_.size()) continue;
-    const bool busy = r.busy && r.busy();
-    r.ports.push_back({b, busy ? &boot_ups_and_answers_ : &boot_ups_, busy ? &answers_ : &nothing_, true});
+    const Reaction reaction = r.reaction ? r.reaction() : Reaction::kAnything;
+    if (reaction == Reaction::kAnything) anything_[b] = true;
+    r.ports.push_back({b, reaction == Reaction::kBootUps ? &boot_ups_ : &boot_ups_and_answers_});
     ++bus_sessions_[b];
   }
   buses_.resize(bus_names_.size());
@@ -430,19 +441,16 @@ void TimeConductor::ComputeHorizons(TimePoint now, std::optional<TimePoint> cap)
     HorizonBus& bus = buses_[b];
     // Calm only if every port that may transmit is a node process's: anything else (a tool, the
     // fleet's own SDO client) may answer what it hears at once, which the horizons do not model.
-    bus.calm = bus_outlook_.calm && bus_outlook_.transmitters == bus_sessions_[b];
+    bus.calm = bus_outlook_.calm && bus_outlook_.transmitters == bus_sessions_[b] && !anything_[b];
     bus.next_event = bus_outlook_.next_event;
-    bus.pending_keys.clear();
-    bus.boot_up = false;
-    for (const CanFrame& f : bus_outlook_.frames) {
-      bus.pending_keys.push_back(Acceptance::KeyOf(f));
-      bus.boot_up = bus.boot_up || (!f.extended() && !f.remote() && f.id > 0x700 && f.id <= 0x77F &&
-                                    f.dlc == 1 && (f.data[0] & 0x7F) == 0);
-    }
+    bus.pending.clear();
+    for (const CanFrame& f : bus_outlook_.frames)
+      bus.pending.push_back({Acceptance::KeyOf(f), IsHeartbeat(f)});
   }
   for (const Participant* p : order_) {
     HorizonNode& node = nodes_.emplace_back();
     node.pending = p->pending;
+    node.reacts_after = p->reacts_after;
     node.next = p->next;
     node.any = p->has_outlook ? p->outlook.any : p->next;
     if (p->has_outlook) node.confined = p->outlook.confined;
@@ -452,7 +460,15 @@ void TimeConductor::ComputeHorizons(TimePoint now, std::optional<TimePoint> cap)
     HorizonNode& node = nodes_.emplace_back();  // no timers of its own: it answers what it hears
     node.ports = r.ports;
   }
-  horizons_.Compute(now, kLookahead, cap, buses_, nodes_);
+  // What the processes sent ahead of the bus, not on it yet.
+  known_.clear();
+  for (const Submission& s : submissions_) {
+    const std::size_t b = bus_index(*s.bus_key);
+    if (b >= bus_names_.size()) continue;
+    known_.push_back(
+        {b, s.participant->round_index, Acceptance::KeyOf(s.frame), s.time, IsHeartbeat(s.frame)});
+  }
+  horizons_.Compute(now, kLookahead, cap, buses_, nodes_, known_);
 }
 
 bool TimeConductor::OpenPerNodeRound(TimePoint now) {

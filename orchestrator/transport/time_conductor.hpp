@@ -134,7 +134,9 @@ class TimeConductor {
   /// The session ends (disconnected, closed, evicted): its process is no longer waited for on it.
   void Leave(GrantedSession& session);
   /// Something was sent to the session's node at the current time: it takes part in the next round.
-  void Pending(GrantedSession& session);
+  /// `reacts_after`: what was sent makes it send nothing before that long (heartbeats it only
+  /// watches, Acceptance::Passive); 0: it may answer at once.
+  void Pending(GrantedSession& session, Duration reacts_after = Duration::zero());
   /// Frames the node sent, stamped with their times: put on the bus at those times.
   void Submit(GrantedSession& session, broker::PortId port, std::span<const wire::StampedFrame> frames);
   /// TimeReached from the session's node, with what its timers may send (nullptr: anything, from
@@ -145,12 +147,20 @@ class TimeConductor {
   bool Participates(const GrantedSession& session) const { return sessions_.contains(&session); }
 
   // --- the broker's own ports that answer at once (the fleet's CANopen master) ---
+  /// What a reactor may answer at once.
+  enum class Reaction : std::uint8_t {
+    kBootUps,            ///< a boot-up (it configures the node)
+    kBootUpsAndAnswers,  ///< and an SDO server's answer (its SDO client is busy)
+    kAnything,           ///< any frame, with frames or node requests (a scenario that reads nodes)
+  };
   /// A port of this process on `bus` that may send as soon as it hears something: the fleet's
-  /// CANopen master configures a node when it sees its boot-up, and its SDO client answers a
-  /// server while `busy()`. Per-node lookahead counts it as a process with no timers of its own
-  /// (its timers are the broker's): without it, a port that transmits and is no node process
-  /// keeps its bus from being calm. Returns the id for RemoveReactor.
-  std::uint64_t AddReactor(std::string bus, std::function<bool()> busy);
+  /// CANopen master configures a node when it sees its boot-up, its SDO client answers a server,
+  /// a scenario's expectation may read a node when a frame opens its window; `reaction()` says
+  /// which now. Per-node lookahead counts it as a process with no timers of its own (its timers
+  /// are the broker's); kAnything holds its bus as one that is not calm. Without it, a port that
+  /// transmits and is no node process keeps its bus from being calm. Returns the id for
+  /// RemoveReactor.
+  std::uint64_t AddReactor(std::string bus, std::function<Reaction()> reaction);
   void RemoveReactor(std::uint64_t id);
 
   // --- outside inputs ---
@@ -203,10 +213,12 @@ class TimeConductor {
     std::size_t ports = 1;                    ///< how many the process attaches (Hello.clock_ports)
     std::optional<TimePoint> next;            ///< its next deadline, as last reported
     bool pending = false;                     ///< something was sent to it at the current time
+    Duration reacts_after{};                  ///< while pending: it sends nothing on it before now + this
     TimePoint reached{};                      ///< the time it has run to (at or after the bus's)
     SendOutlook outlook;                      ///< what its timers may send, as last reported
     bool has_outlook = false;                 ///< it said (else: anything from `next`)
     std::vector<HorizonPort> ports_of_round;  ///< its sessions' buses and filters (reused)
+    std::size_t round_index = 0;              ///< in order_ (ComputeHorizons)
   };
   struct SessionState {
     Participant* participant = nullptr;
@@ -248,7 +260,7 @@ class TimeConductor {
   TimePoint Frontier() const;
   /// No process stands beyond the bus's time: outside inputs may be applied now.
   bool CaughtUp() const { return Frontier() <= Now(); }
-  void MarkPending(Participant& p);
+  void MarkPending(Participant& p, Duration reacts_after = Duration::zero());
   void RunBoundaryActions();
   /// Forgets processes whose every session left (and the frames they still had to go).
   void Prune();
@@ -283,20 +295,23 @@ class TimeConductor {
   struct Reactor {
     std::uint64_t id = 0;
     std::string bus;
-    std::function<bool()> busy;
+    std::function<Reaction()> reaction;
     std::vector<HorizonPort> ports;  ///< one (reused)
   };
   std::vector<Reactor> reactors_;
   std::uint64_t next_reactor_ = 1;
-  /// What a reactor hears: boot-ups (700h + node-ID), and SDO answers (580h + node-ID) while busy.
-  Acceptance boot_ups_, boot_ups_and_answers_, answers_, nothing_;
+  /// What a reactor answers: boot-ups (700h + node-ID, whose heartbeats it only watches), and SDO
+  /// answers (580h + node-ID) while busy.
+  Acceptance boot_ups_, boot_ups_and_answers_;
 
   // Per-node lookahead (reused between rounds).
   std::vector<Participant*> order_;
   std::vector<std::string> bus_names_;
   std::vector<HorizonBus> buses_;
   std::vector<std::size_t> bus_sessions_;  ///< per bus: sessions of participants on it
+  std::vector<bool> anything_;             ///< per bus: a reactor may answer anything at once
   std::vector<HorizonNode> nodes_;
+  std::vector<KnownFrame> known_;
   broker::BusOutlook bus_outlook_;
   TimerOutlook broker_timers_;
   GrantHorizons horizons_;

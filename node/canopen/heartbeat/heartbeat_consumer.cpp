@@ -110,6 +110,14 @@ void HeartbeatConsumer::AddListenedIds(std::vector<std::uint32_t>& ids) const {
     if (entry->state != State::kUnconfigured) ids.push_back(kErrorControlCobId + entry->node_id);
 }
 
+void HeartbeatConsumer::AddPassiveIds(std::vector<std::pair<std::uint32_t, Duration>>& out) const {
+  // Receive: a heartbeat (not a boot-up) from a producer that is not timed out only records its
+  // state and re-arms the timeout, `period` from its arrival; nothing is sent at once.
+  for (const auto& entry : entries_)
+    if (entry->state == State::kWaiting || entry->state == State::kActive)
+      out.emplace_back(kErrorControlCobId + entry->node_id, entry->period);
+}
+
 bool HeartbeatConsumer::OnFrame(const CanFrame& frame) {
   if (frame.extended() || frame.remote() || frame.error()) return false;
   if (frame.id <= kErrorControlCobId || frame.id > kErrorControlCobId + 127 || frame.dlc != 1) return false;

@@ -64,6 +64,10 @@ class HeartbeatConsumer {
   bool OnFrame(const CanFrame& frame);
   /// The 11-bit identifiers it listens to: the heartbeats of the nodes it monitors (1016h).
   void AddListenedIds(std::vector<std::uint32_t>& ids) const;
+  /// The heartbeats whose arrival makes the node send nothing at once (virtual time, per-node
+  /// lookahead): each watched producer that has not timed out, with its consumer time, before
+  /// which nothing follows from it.
+  void AddPassiveIds(std::vector<std::pair<std::uint32_t, Duration>>& out) const;
 
   /// Restarts monitoring (reset communication): every configured entry goes back to waiting.
   void Reset();

@@ -22,7 +22,8 @@ void HeartbeatProducer::SetNodeId(std::uint8_t node_id) {
   node_id_ = node_id;
   // Its timer sends the heartbeat and nothing else: in virtual time, a node that does not listen
   // to it is not held back by it (Timer::Confine).
-  timer_.Confine(IsValidNodeId(node_id_) ? kErrorControlCobId + node_id_ : Timer::kUnconfined);
+  timer_.Confine(IsValidNodeId(node_id_) ? (kErrorControlCobId + node_id_) | Timer::kHeartbeat
+                                         : Timer::kUnconfined);
 }
 
 Duration HeartbeatProducer::Period() const {

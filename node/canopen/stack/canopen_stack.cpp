@@ -190,6 +190,23 @@ void CanopenStack::ApplyNodeId(std::uint8_t node_id) {
   ResetCommunication();
 }
 
+std::vector<std::pair<std::uint32_t, Duration>> CanopenStack::PassiveIds() const {
+  std::vector<std::pair<std::uint32_t, Duration>> passive;
+  if (!Configured()) return passive;
+  hb_consumer_.AddPassiveIds(passive);
+  // An identifier another service listens to too (an RPDO on 7xxh) is not passive.
+  std::vector<std::uint32_t> others;
+  LssSlave::AddListenedIds(others);
+  NmtSlave::AddListenedIds(others);
+  guarding_.AddListenedIds(others);
+  sdo_.AddListenedIds(others);
+  sync_.AddListenedIds(others);
+  pdo_.AddListenedIds(others);
+  std::erase_if(passive, [&](const auto& p) { return std::ranges::find(others, p.first) != others.end(); });
+  std::sort(passive.begin(), passive.end());
+  return passive;
+}
+
 std::vector<std::uint32_t> CanopenStack::ListenedIds() const {
   // The same services, in the same order, as OnFrame routes to.
   std::vector<std::uint32_t> ids;

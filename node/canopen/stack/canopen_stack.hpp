@@ -112,6 +112,9 @@ class CanopenStack final : private CommErrorSink {
   /// NMT state: a filter changes only with a write, an LSS command or a reset, each of which the
   /// node answers, so in real time the new filter reaches the broker with that answer.
   std::vector<std::uint32_t> ListenedIds() const;
+  /// Of ListenedIds, the heartbeats answered with nothing at once, each with the time before
+  /// which nothing follows from it (HeartbeatConsumer::AddPassiveIds).
+  std::vector<std::pair<std::uint32_t, Duration>> PassiveIds() const;
 
   /// Local NMT transition (device logic, tests). Same effect as the NMT command.
   void SetState(NmtState state) { nmt_.SetState(state); }

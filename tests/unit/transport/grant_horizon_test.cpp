@@ -24,6 +24,7 @@ class Horizons : public ::testing::Test {
  protected:
   struct Node {
     bool pending = false;
+    Duration reacts_after{};
     std::optional<TimePoint> next;
     std::optional<TimePoint> any;
     std::vector<ConfinedSend> confined;
@@ -47,15 +48,16 @@ class Horizons : public ::testing::Test {
     n.confined = std::move(confined);
     return n;
   }
-  std::optional<TimePoint> Compute(TimePoint now = TimePoint{}, std::optional<TimePoint> cap = std::nullopt) {
+  std::optional<TimePoint> Compute(TimePoint now = TimePoint{}, std::optional<TimePoint> cap = std::nullopt,
+                                   std::vector<KnownFrame> known = {}) {
     std::vector<HorizonNode> nodes;
     for (Node& n : fleet) {
       n.ports.clear();
       for (const std::size_t b : n.buses)
         n.ports.push_back({b, &n.acceptance});
-      nodes.push_back({n.pending, n.next, n.any, n.confined, n.ports});
+      nodes.push_back({n.pending, n.reacts_after, n.next, n.any, n.confined, n.ports});
     }
-    horizons.Compute(now, L, cap, buses, nodes);
+    horizons.Compute(now, L, cap, buses, nodes, known);
     return horizons.Of(0);
   }
 
@@ -70,7 +72,7 @@ ConfinedSend Tpdo(std::uint32_t n, Duration at) {
   return {0x180 + n, At(at)};
 }
 ConfinedSend Heartbeat(std::uint32_t n, Duration at) {
-  return {0x700 + n, At(at)};
+  return {0x700 + n, At(at), true};
 }
 constexpr Duration kFar = 1500ms;
 
@@ -150,11 +152,11 @@ TEST_F(Horizons, AFrameOnTheBusThatANodeListensToBoundsIt) {
   Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
   Add({0x7FF}, 900ms, {Heartbeat(1, 500ms)}, kFar);
   buses[0].next_event = At(3ms);
-  buses[0].pending_keys = {0x181};
+  buses[0].pending = {{0x181, false}};
   EXPECT_EQ(Compute(), At(500ms + L)) << "it does not listen to 181h";
-  buses[0].pending_keys = {0x181, 0x701};
+  buses[0].pending = {{0x181, false}, {0x701, false}};
   EXPECT_EQ(Compute(), At(3ms));
-  buses[0].pending_keys = {Acceptance::kExtendedKey};
+  buses[0].pending = {{Acceptance::kExtendedKey, false}};
   EXPECT_EQ(Compute(), At(3ms)) << "29-bit frames always pass the filter";
 }
 
@@ -169,6 +171,73 @@ TEST_F(Horizons, TheCapAndTheOtherBusesOfAProcess) {
   fleet[0].acceptance.Set(false, listens);
   EXPECT_EQ(Compute(), At(5ms + L)) << "node 0 listens on bus 1 too, where node 2 may send anything";
   EXPECT_EQ(horizons.Of(1), At(5ms + 2 * L)) << "node 0 may answer on bus 0 what it hears from node 2";
+}
+
+// A heartbeat consumer answers a heartbeat with nothing (it re-arms its timeout): the ring of
+// consumers is no longer held to its earliest heartbeat; each node reaches its producer's.
+TEST_F(Horizons, PassiveHeartbeatsDoNotTravelAroundTheRing) {
+  Add({0x701}, 20ms, {Tpdo(0, 20ms), Heartbeat(0, 300ms)}, kFar);
+  Add({0x702}, 10ms, {Tpdo(1, 10ms), Heartbeat(1, 100ms)}, kFar);
+  Add({0x700}, 30ms, {Tpdo(2, 30ms), Heartbeat(2, 200ms)}, kFar);
+  Compute();
+  EXPECT_EQ(horizons.Of(2), At(100ms + 2 * L)) << "not passive: the earliest heartbeat, around the ring";
+  for (std::uint32_t n = 0; n < 3; ++n) {
+    const std::vector<std::uint32_t> ids{0x700 + (n + 1) % 3};
+    const std::vector<Acceptance::Passive> passive{{0x700 + (n + 1) % 3, 1500ms}};
+    fleet[n].acceptance.Set(false, ids, passive);
+  }
+  EXPECT_EQ(Compute(), At(100ms + L));
+  EXPECT_EQ(horizons.Of(1), At(200ms + L));
+  EXPECT_EQ(horizons.Of(2), At(300ms + L));
+}
+
+// A boot-up is no heartbeat: what a node sends on input (or from an unconfined timer) on a passive
+// identifier may still be answered at once.
+TEST_F(Horizons, APassiveIdentifierSentOnInputIsAnsweredAtOnce) {
+  Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
+  Node& sender = Add({0x7FF}, 900ms, {Heartbeat(1, 500ms)}, kFar);
+  const std::vector<std::uint32_t> ids{0x701};
+  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
+  fleet[0].acceptance.Set(false, ids, passive);
+  Add({0x180}, 900ms, {Heartbeat(2, 800ms)}, kFar);  // hears node 0's TPDO
+  EXPECT_EQ(Compute(), At(500ms + L));
+  EXPECT_EQ(horizons.Of(2), At(900ms + L)) << "node 0 answers the heartbeat only 1500 ms later";
+  sender.pending = true;
+  EXPECT_EQ(Compute(At(5ms)), At(5ms + L));
+  EXPECT_EQ(horizons.Of(2), At(5ms + L)) << "a pending node may send anything, a boot-up too";
+}
+
+// Node 1 ran ahead of the bus and sent its heartbeat at 10 ms (not on the bus yet); its timer's
+// next is at 510 ms. Node 0 hears the one sent, even though it only re-arms its timeout.
+TEST_F(Horizons, AFrameSentAheadOfTheBusReachesItsListeners) {
+  Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
+  Add({0x7FF}, 900ms, {Heartbeat(1, 510ms)}, kFar);
+  const std::vector<std::uint32_t> ids{0x701};
+  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
+  fleet[0].acceptance.Set(false, ids, passive);
+  EXPECT_EQ(Compute(), At(510ms + L));
+  EXPECT_EQ(Compute(TimePoint{}, std::nullopt, {{0, 1, 0x701, At(10ms), true}}), At(10ms + L));
+  EXPECT_EQ(Compute(TimePoint{}, std::nullopt, {{0, 1, 0x181, At(10ms), false}}), At(510ms + L))
+      << "a frame it does not listen to";
+  EXPECT_EQ(Compute(TimePoint{}, std::nullopt, {{0, 1, Acceptance::kExtendedKey, At(10ms), false}}),
+            At(10ms + L))
+      << "a 29-bit frame passes every filter";
+}
+
+// A node woken by a heartbeat it only watches (pending, but passive for 1500 ms) does not hold the
+// others to now: it answers nothing before its delay.
+TEST_F(Horizons, ANodeWokenByAPassiveHeartbeatDoesNotHoldTheOthers) {
+  Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
+  Add({0x7FF}, 900ms, {Heartbeat(1, 510ms)}, kFar);
+  const std::vector<std::uint32_t> ids{0x701};
+  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
+  fleet[0].acceptance.Set(false, ids, passive);
+  fleet[0].pending = true;
+  EXPECT_EQ(Compute(At(10ms)), At(10ms + 2 * L));
+  EXPECT_EQ(horizons.Of(1), At(10ms + L)) << "pending, node 0 may answer at once";
+  fleet[0].reacts_after = 1500ms;
+  EXPECT_EQ(Compute(At(10ms)), At(510ms + L));
+  EXPECT_EQ(horizons.Of(1), At(kFar + L)) << "node 0 answers nothing before its other timers";
 }
 
 TEST_F(Horizons, NothingReachesANodeThatListensToNothing) {
