@@ -185,6 +185,7 @@ void TimeConductor::AtBoundary(std::function<void()> action) {
     return;
   }
   boundary_.push_back(std::move(action));
+  Kick();  // processes may stand ahead of the bus: rounds bring it up to them
 }
 
 void TimeConductor::Hold() {
@@ -492,6 +493,12 @@ bool TimeConductor::OpenPerNodeRound(TimePoint now) {
     any_due = any_due || p->next.has_value();
   if (!any_due && !scheduler_.NextDeadline()) {
     run_wall_start_.reset();  // nothing will ever happen: time stands still
+    if (catching_up) {
+      // Nothing happens before the furthest process: the bus is there at once (outside inputs
+      // wait for it).
+      scheduler_.AdvanceTo(Frontier());
+      Kick();
+    }
     return false;
   }
   const auto wall_now = std::chrono::steady_clock::now();
@@ -581,11 +588,15 @@ void TimeConductor::CloseRound() {
   if (per_node_round_) {
     // The bus runs up to the earliest deadline of any process: until then none sends anything it
     // has not sent already, unless something reaches it first (then the bus stops there).
-    TimePoint target = Now() + kMaxGrant;
+    std::optional<TimePoint> earliest;  // of any process
     for (const auto& [id, p] : participants_) {
-      if (p.pending) target = Now();
-      if (p.next) target = std::min(target, *p.next);
+      if (p.pending) earliest = Now();
+      if (p.next && (!earliest || *p.next < *earliest)) earliest = *p.next;
     }
+    // No process has anything to do: the bus runs to its own next event, or up to the furthest
+    // process; time does not run on for nothing.
+    TimePoint target = earliest ? *earliest : std::max(Frontier(), scheduler_.NextDeadline().value_or(Now()));
+    target = std::min(target, Now() + kMaxGrant);
     if (holds_ > 0 || !boundary_.empty() || !PerNode())
       target = std::min(target, std::max(Frontier(), Now()));
     AdvanceBrokerUntilInput(std::max(target, Now()));

@@ -470,6 +470,20 @@ TEST_F(PerNode, AnOutsideInputWaitsForTheBusToCatchUpWithTheProcesses) {
   EXPECT_EQ(Ns(applied->time_since_epoch()), Ns(500ms) + 2 * L) << "where b stood, the furthest";
 }
 
+// Nothing is due anywhere, but a process stands ahead of the bus: an outside input still runs,
+// once the bus has caught up with it.
+TEST_F(PerNode, AnOutsideInputRunsWhenNothingIsDueAhead) {
+  FirstAnswers();
+  ASSERT_TRUE(a.Reach(std::nullopt));
+  ASSERT_TRUE(b.Reach(std::nullopt));
+  Poll();
+  std::optional<TimePoint> applied;
+  conductor.AtBoundary([&] { applied = conductor.Now(); });
+  Poll();
+  ASSERT_TRUE(applied) << "it did not wait for ever";
+  EXPECT_EQ(Ns(applied->time_since_epoch()), Ns(500ms) + 2 * L) << "where b stood, the furthest";
+}
+
 // A frame goes on the bus at its stamp although its sender stands further; its listener is woken
 // at its end of frame, where the bus stops.
 TEST_F(PerNode, AFrameReachesItsListenerAtItsEndOfFrame) {
