@@ -14,6 +14,18 @@ std::string TimeText(TimePoint t) {
   return std::to_string(std::chrono::duration<double>(t.time_since_epoch()).count()) + " s";
 }
 
+/// Sets a flag for as long as it lives.
+class FlagScope {
+ public:
+  explicit FlagScope(bool& flag) : flag_(flag) { flag_ = true; }
+  ~FlagScope() { flag_ = false; }
+  FlagScope(const FlagScope&) = delete;
+  FlagScope& operator=(const FlagScope&) = delete;
+
+ private:
+  bool& flag_;
+};
+
 /// Rounds run one after another in one handler before the event loop gets a turn (other
 /// sessions, control requests): enough to amortise the turn, few enough to stay responsive.
 constexpr int kRoundsPerTurn = 64;
@@ -370,28 +382,21 @@ bool TimeConductor::OpenRound() {
   round_open_ = true;
   round_until_ = until;
   outstanding_ = 0;
-  for (auto& [id, p] : participants_) {
-    if (!p.pending && !(p.next && *p.next <= until)) continue;
-    if (p.pending) --pending_count_;
-    p.pending = false;
-    for (GrantedSession* s : p.sessions) {
-      SessionState& state = sessions_[s];
-      state.granted = true;
-      state.now = now;
-      state.until = until;
-      ++outstanding_;
-    }
+  for (auto& [id, p] : participants_)
+    if (p.pending || (p.next && *p.next <= until)) MarkGranted(p, now, until);
+  return SendGrants();
+}
+
+void TimeConductor::MarkGranted(Participant& p, TimePoint now, TimePoint until) {
+  if (p.pending) --pending_count_;
+  p.pending = false;
+  for (GrantedSession* s : p.sessions) {
+    SessionState& state = sessions_[s];
+    state.granted = true;
+    state.now = now;
+    state.until = until;
+    ++outstanding_;
   }
-  SendGrants();
-  if (outstanding_ == 0) {
-    CloseRound();
-    return true;
-  }
-  // One OS timer for many rounds: armed only when none is pending (re-arming it for every round
-  // of a few microseconds cost two timerfd syscalls each); it checks the open round's age.
-  round_opened_ = std::chrono::steady_clock::now();
-  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
-  return true;
 }
 
 TimePoint TimeConductor::Frontier() const {
@@ -520,27 +525,12 @@ bool TimeConductor::OpenPerNodeRound(TimePoint now) {
       if (!p.pending) continue;  // it is there already
       until = p.reached;         // a causality error, counted when it became pending
     }
-    if (p.pending) --pending_count_;
-    p.pending = false;
-    for (GrantedSession* session : p.sessions) {
-      SessionState& state = sessions_[session];
-      state.granted = true;
-      state.now = now;
-      state.until = until;
-      ++outstanding_;
-    }
+    MarkGranted(p, now, until);
   }
-  SendGrants();
-  if (outstanding_ == 0) {
-    CloseRound();
-    return true;
-  }
-  round_opened_ = std::chrono::steady_clock::now();
-  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
-  return true;
+  return SendGrants();
 }
 
-void TimeConductor::SendGrants() {
+bool TimeConductor::SendGrants() {
   // Granted after marking: a session failing in SendGrant leaves with its grant counted.
   std::vector<GrantedSession*> granted;
   for (auto& [s, state] : sessions_)
@@ -565,6 +555,15 @@ void TimeConductor::SendGrants() {
     s->SendGrant(it->second.now, it->second.until, attachments_);
   }
   granting_ = false;
+  if (outstanding_ == 0) {
+    CloseRound();
+    return true;
+  }
+  // One OS timer for many rounds: armed only when none is pending (re-arming it for every round
+  // of a few microseconds cost two timerfd syscalls each); it checks the open round's age.
+  round_opened_ = std::chrono::steady_clock::now();
+  if (!grace_armed_) ArmGrace(round_opened_ + options_.grace);
+  return true;
 }
 
 void TimeConductor::ArmGrace(std::chrono::steady_clock::time_point at) {
@@ -611,25 +610,12 @@ void TimeConductor::CloseRound() {
 }
 
 void TimeConductor::AdvanceBroker(TimePoint until) {
-  advancing_ = true;
-  struct Done {
-    bool& flag;
-    ~Done() { flag = false; }
-  } done{advancing_};
+  const FlagScope advancing(advancing_);
   const TimePoint start = Now();
-  std::stable_sort(submissions_.begin(), submissions_.end(), [](const Submission& a, const Submission& b) {
-    if (a.time != b.time) return a.time < b.time;
-    if (a.participant != b.participant) return a.participant->clock_id < b.participant->clock_id;
-    if (*a.bus_key != *b.bus_key) return *a.bus_key < *b.bus_key;
-    return a.sequence < b.sequence;
-  });
+  SortSubmissions();
   std::size_t taken = 0;
   for (; taken < submissions_.size() && submissions_[taken].time <= until; ++taken) {
-    const Submission& s = submissions_[taken];
-    if (s.time < Now()) ++stats_.late_frames;
-    scheduler_.AdvanceTo(s.time);  // a time in the past is now
-    broker_.Submit(s.port, s.frame);
-    ++stats_.frames;
+    PutOnBus(submissions_[taken]);
   }
   submissions_.erase(submissions_.begin(), submissions_.begin() + static_cast<std::ptrdiff_t>(taken));
   scheduler_.AdvanceTo(until);
@@ -637,20 +623,28 @@ void TimeConductor::AdvanceBroker(TimePoint until) {
   Prune();  // processes that left meanwhile
 }
 
-void TimeConductor::AdvanceBrokerUntilInput(TimePoint until) {
-  advancing_ = true;
-  struct Done {
-    bool& flag;
-    ~Done() { flag = false; }
-  } done{advancing_};
-  const TimePoint start = Now();
-  const int holds_at_start = holds_;
+void TimeConductor::PutOnBus(const Submission& s) {
+  if (s.time < Now()) ++stats_.late_frames;
+  scheduler_.AdvanceTo(s.time);  // the broker's timers due by then first; a time in the past is now
+  broker_.Submit(s.port, s.frame);
+  ++stats_.frames;
+}
+
+void TimeConductor::SortSubmissions() {
+  // The tie rule for frames stamped at one instant: by process name, bus, then the order sent.
   std::stable_sort(submissions_.begin(), submissions_.end(), [](const Submission& a, const Submission& b) {
     if (a.time != b.time) return a.time < b.time;
     if (a.participant != b.participant) return a.participant->clock_id < b.participant->clock_id;
     if (*a.bus_key != *b.bus_key) return *a.bus_key < *b.bus_key;
     return a.sequence < b.sequence;
   });
+}
+
+void TimeConductor::AdvanceBrokerUntilInput(TimePoint until) {
+  const FlagScope advancing(advancing_);
+  const TimePoint start = Now();
+  const int holds_at_start = holds_;
+  SortSubmissions();
   // Instant by instant, in the order AdvanceBroker takes them (each frame after the timers due by
   // its time), so that the bus is the same whichever way it was granted.
   std::size_t taken = 0;
@@ -665,11 +659,7 @@ void TimeConductor::AdvanceBrokerUntilInput(TimePoint until) {
       break;
     }
     for (; taken < submissions_.size() && submissions_[taken].time <= *instant; ++taken) {
-      const Submission& s = submissions_[taken];
-      if (s.time < Now()) ++stats_.late_frames;
-      scheduler_.AdvanceTo(s.time);
-      broker_.Submit(s.port, s.frame);
-      ++stats_.frames;
+      PutOnBus(submissions_[taken]);
     }
     scheduler_.AdvanceTo(*instant);
   }

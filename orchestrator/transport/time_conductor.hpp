@@ -243,8 +243,15 @@ class TimeConductor {
   bool OpenRound();
   /// The same with per-node lookahead: each process to its own horizon.
   bool OpenPerNodeRound(TimePoint now);
-  /// Grant each session marked granted (SessionState::now/until), in a stated order.
-  void SendGrants();
+  /// Marks every session of `p` granted from `now` to `until` in the round being opened.
+  void MarkGranted(Participant& p, TimePoint now, TimePoint until);
+  /// Grants each session marked granted (SessionState::now/until), in a stated order; closes the
+  /// round at once when none is, else waits for the answers (the grace timer). True.
+  bool SendGrants();
+  /// Submissions in the order they go on the buses (ties: README "Ties").
+  void SortSubmissions();
+  /// Puts a node's frame on its bus at its stamp.
+  void PutOnBus(const Submission& s);
   void CloseRound();
   void AdvanceBroker(TimePoint until);
   /// Per-node lookahead: runs the bus up to `until`, instant by instant, and stops after the first

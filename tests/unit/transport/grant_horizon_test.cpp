@@ -48,6 +48,12 @@ class Horizons : public ::testing::Test {
     n.confined = std::move(confined);
     return n;
   }
+  /// The node listens only to `heartbeat`, which it answers with nothing before 1500 ms.
+  static void ListenPassively(Node& n, std::uint32_t heartbeat) {
+    const std::vector<std::uint32_t> ids{heartbeat};
+    const std::vector<Acceptance::Passive> passive{{heartbeat, 1500ms}};
+    n.acceptance.Set(false, ids, passive);
+  }
   std::optional<TimePoint> Compute(TimePoint now = TimePoint{}, std::optional<TimePoint> cap = std::nullopt,
                                    std::vector<KnownFrame> known = {}) {
     std::vector<HorizonNode> nodes;
@@ -182,9 +188,7 @@ TEST_F(Horizons, PassiveHeartbeatsDoNotTravelAroundTheRing) {
   Compute();
   EXPECT_EQ(horizons.Of(2), At(100ms + 2 * L)) << "not passive: the earliest heartbeat, around the ring";
   for (std::uint32_t n = 0; n < 3; ++n) {
-    const std::vector<std::uint32_t> ids{0x700 + (n + 1) % 3};
-    const std::vector<Acceptance::Passive> passive{{0x700 + (n + 1) % 3, 1500ms}};
-    fleet[n].acceptance.Set(false, ids, passive);
+    ListenPassively(fleet[n], 0x700 + (n + 1) % 3);
   }
   EXPECT_EQ(Compute(), At(100ms + L));
   EXPECT_EQ(horizons.Of(1), At(200ms + L));
@@ -196,9 +200,7 @@ TEST_F(Horizons, PassiveHeartbeatsDoNotTravelAroundTheRing) {
 TEST_F(Horizons, APassiveIdentifierSentOnInputIsAnsweredAtOnce) {
   Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
   Node& sender = Add({0x7FF}, 900ms, {Heartbeat(1, 500ms)}, kFar);
-  const std::vector<std::uint32_t> ids{0x701};
-  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
-  fleet[0].acceptance.Set(false, ids, passive);
+  ListenPassively(fleet[0], 0x701);
   Add({0x180}, 900ms, {Heartbeat(2, 800ms)}, kFar);  // hears node 0's TPDO
   EXPECT_EQ(Compute(), At(500ms + L));
   EXPECT_EQ(horizons.Of(2), At(900ms + L)) << "node 0 answers the heartbeat only 1500 ms later";
@@ -212,9 +214,7 @@ TEST_F(Horizons, APassiveIdentifierSentOnInputIsAnsweredAtOnce) {
 TEST_F(Horizons, AFrameSentAheadOfTheBusReachesItsListeners) {
   Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
   Add({0x7FF}, 900ms, {Heartbeat(1, 510ms)}, kFar);
-  const std::vector<std::uint32_t> ids{0x701};
-  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
-  fleet[0].acceptance.Set(false, ids, passive);
+  ListenPassively(fleet[0], 0x701);
   EXPECT_EQ(Compute(), At(510ms + L));
   EXPECT_EQ(Compute(TimePoint{}, std::nullopt, {{0, 1, 0x701, At(10ms), true}}), At(10ms + L));
   EXPECT_EQ(Compute(TimePoint{}, std::nullopt, {{0, 1, 0x181, At(10ms), false}}), At(510ms + L))
@@ -229,9 +229,7 @@ TEST_F(Horizons, AFrameSentAheadOfTheBusReachesItsListeners) {
 TEST_F(Horizons, ANodeWokenByAPassiveHeartbeatDoesNotHoldTheOthers) {
   Add({0x701}, 900ms, {Tpdo(0, 900ms)}, kFar);
   Add({0x7FF}, 900ms, {Heartbeat(1, 510ms)}, kFar);
-  const std::vector<std::uint32_t> ids{0x701};
-  const std::vector<Acceptance::Passive> passive{{0x701, 1500ms}};
-  fleet[0].acceptance.Set(false, ids, passive);
+  ListenPassively(fleet[0], 0x701);
   fleet[0].pending = true;
   EXPECT_EQ(Compute(At(10ms)), At(10ms + 2 * L));
   EXPECT_EQ(horizons.Of(1), At(10ms + L)) << "pending, node 0 may answer at once";
