@@ -111,6 +111,10 @@ int RunFleet(const UpOptions& options) {
     std::cerr << "canfleet up: --driven needs virtual time (--time virtual)\n";
     return 2;
   }
+  // A test steps driven time and may act on whatever it sees at once: one grant for all from the
+  // start, so that no process stands ahead of the time the test sees (per-node lookahead would have
+  // them there when the fleet becomes ready and time stops for the driver).
+  if (options.driven) time.conductor.lookahead = transport::TimeConductorOptions::Lookahead::kGlobal;
   host::BrokerHost host(io, socketcand_options, time);
   std::unique_ptr<Fleet> fleet;
   std::unique_ptr<BoundaryControlHandler> boundary;
