@@ -2,22 +2,12 @@
 
 #include <algorithm>
 
+#include "vocabulary/nmt_state.hpp"
+
 namespace canfleet::fleet {
 
 const char* NmtStateName(std::optional<std::uint8_t> state) {
-  if (!state) return "unknown";
-  switch (*state) {
-    case 0x00:
-      return "initialising";
-    case 0x04:
-      return "stopped";
-    case 0x05:
-      return "operational";
-    case 0x7F:
-      return "pre-operational";
-    default:
-      return "unknown";
-  }
+  return state ? canopen::ToString(static_cast<canopen::NmtState>(*state)) : "unknown";
 }
 
 void NodeTracker::Observe(const std::string& bus, const CanFrame& frame, TimePoint now) {

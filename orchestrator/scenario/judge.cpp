@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "orchestrator/control/sdo_value.hpp"
+#include "vocabulary/nmt_state.hpp"
 
 namespace canfleet::scenario {
 
@@ -236,19 +237,9 @@ class StateJudge : public Judge {
   std::string first_, last_;
 };
 
+/// The state of a heartbeat or guarding reply (bit 7: the guarding toggle bit).
 const char* NmtName(std::uint8_t state) {
-  switch (state & 0x7F) {
-    case 0x00:
-      return "initialising";
-    case 0x04:
-      return "stopped";
-    case 0x05:
-      return "operational";
-    case 0x7F:
-      return "pre-operational";
-    default:
-      return "unknown";
-  }
+  return canopen::ToString(static_cast<canopen::NmtState>(state & 0x7F));
 }
 
 class NmtJudge final : public StateJudge {
