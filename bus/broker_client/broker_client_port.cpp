@@ -399,7 +399,7 @@ class BrokerClientPort::Link : public std::enable_shared_from_this<Link>, public
         f.passive.emplace_back(id, delay.count());
     return f;
   }
-  void AddFilter(wire::MessageWriter& out, const Filter& f) { out.AddAcceptance(f.ids, f.passive); }
+  static void AddFilter(wire::MessageWriter& out, const Filter& f) { out.AddAcceptance(f.ids, f.passive); }
 
   bool AcceptanceChanged() override {
     if (!acceptance || phase_ != Phase::kConnected) return false;

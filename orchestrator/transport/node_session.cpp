@@ -497,12 +497,13 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
     return;
   }
   const std::uint8_t* records = transport::SharedRecords(round);
+  Duration reacts_after = Duration::zero();  // every frame: it may answer at once
   if (!acceptance_.All()) {
     // What the node does not listen to does not wake it (its acceptance filter). When it takes
     // every frame of the round, they go out as without a filter (gathered, below).
     const std::span<const broker::TimedFrame> all = round.Frames();
     std::size_t accepted = 0;
-    Duration reacts_after = Duration::max();
+    reacts_after = Duration::max();
     for (const broker::FrameRun& run : runs) {
       for (std::uint32_t i = run.begin; i < run.end; ++i) {
         if (!Accepts(all[i].frame)) continue;
@@ -521,15 +522,6 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
       Queued(reacts_after);
       return;
     }
-    if (granted_) {
-      // Every frame of the round passes the filter: gathered below, and as passive as they are.
-      filling_.ExpectFrames(wire::MessageType::kFrames, frames);
-      for (const broker::FrameRun& run : runs)
-        filling_.AddRecords(wire::MessageType::kFrames,
-                            records + std::size_t{run.begin} * wire::kFrameRecordSize, run.size());
-      Queued(reacts_after);
-      return;
-    }
   }
   // In virtual time the grant that follows sends the frames: frames and grant in one write.
   if (!granted_ && !write_in_flight_ && socket_.is_open() && runs.size() <= kMaxGatherRuns &&
@@ -542,7 +534,7 @@ void NodeSession::DeliverShared(const broker::SharedRound& round, std::span<cons
   for (const broker::FrameRun& run : runs)
     filling_.AddRecords(wire::MessageType::kFrames, records + std::size_t{run.begin} * wire::kFrameRecordSize,
                         run.size());
-  Queued();
+  Queued(reacts_after);
 }
 
 void NodeSession::WriteGathered(const std::uint8_t* records, std::span<const broker::FrameRun> runs,
